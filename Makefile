@@ -1,0 +1,96 @@
+# creaturegen: self-bootstrapping entry points. A clean clone needs only python3 (>= 3.11),
+# node/npm and, for the browser tests, root or password-less sudo on Debian (or network for
+# Playwright's Chromium). `make build` and `make test` install everything else on first use.
+
+SHELL := /bin/bash
+.SHELLFLAGS := -euo pipefail -c
+.DEFAULT_GOAL := help
+.DELETE_ON_ERROR:
+
+PYTHON ?= python3
+VENV := .venv
+VENV_PY := $(VENV)/bin/python
+VENV_STAMP := $(VENV)/.installed
+WEB_LAB := web_lab
+NODE_STAMP := $(WEB_LAB)/node_modules/.package-lock.json
+EXAMPLE ?= examples/lizard.json
+LAB_HOST ?= 127.0.0.1
+LAB_PORT ?= 8765
+# Extra pytest arguments for local runs, e.g. PYTEST_ARGS='-k smoke'. CI leaves it empty: every test
+# runs, browser-marked ones included, and "no tests collected" (exit 5) fails like any other error.
+PYTEST_ARGS ?=
+# Only folders that exist: git does not keep empty ones, and ruff fails on a missing path.
+LINT_PATHS := $(wildcard generator tests bench)
+
+.PHONY: help setup system-deps build test schemas lab clean distclean
+
+help:
+	@echo "make setup    .venv + pip install -e '.[dev]', npm ci in $(WEB_LAB), chromium + lavapipe"
+	@echo "make build    creaturegen build \$$EXAMPLE (now $(EXAMPLE)) into out/"
+	@echo "make test     ruff, ruff format --check, mypy, pytest (browser tests included)"
+	@echo "make schemas  export JSON Schemas into schemas/"
+	@echo "make lab      serve $(WEB_LAB)/ at http://$(LAB_HOST):$(LAB_PORT)/"
+	@echo "make clean    remove build output and caches; distclean also removes .venv and node_modules"
+
+# --- setup ------------------------------------------------------------------------------------
+
+$(VENV_PY):
+	@echo "==> creating $(VENV) with $$($(PYTHON) --version)"
+	@$(PYTHON) -c 'import sys; sys.exit(0 if sys.version_info >= (3, 11) else "creaturegen needs Python >= 3.11")'
+	@bash tools/ensure-system-deps.sh venv $(PYTHON)
+	$(PYTHON) -m venv $(VENV)
+
+$(VENV_STAMP): pyproject.toml | $(VENV_PY)
+	@echo "==> installing creaturegen[dev] into $(VENV)"
+	$(VENV_PY) -m pip install --disable-pip-version-check --quiet -e '.[dev]'
+	@touch $@
+
+$(NODE_STAMP): $(WEB_LAB)/package.json $(WEB_LAB)/package-lock.json
+	@command -v npm >/dev/null || { echo "error: npm not found; install Node.js >= 18 (e.g. apt-get install nodejs npm)" >&2; exit 1; }
+	@echo "==> npm ci in $(WEB_LAB)"
+	cd $(WEB_LAB) && npm ci --no-audit --no-fund
+	@touch $@
+
+system-deps: $(VENV_STAMP)
+	@bash tools/ensure-system-deps.sh runtime $(VENV_PY)
+
+setup: $(VENV_STAMP) $(NODE_STAMP) system-deps
+	@echo "==> setup done"
+
+# --- products ---------------------------------------------------------------------------------
+
+build: setup
+	@echo "==> creaturegen build $(EXAMPLE)"
+	$(VENV)/bin/creaturegen build $(EXAMPLE)
+
+schemas: $(VENV_STAMP)
+	@echo "==> exporting JSON Schemas into schemas/"
+	$(VENV)/bin/creaturegen schema --out schemas
+
+lab: $(VENV_STAMP) $(NODE_STAMP)
+	$(VENV_PY) -m creaturegen.lab.server --root $(WEB_LAB) --host $(LAB_HOST) --port $(LAB_PORT)
+
+# --- checks -----------------------------------------------------------------------------------
+
+test: setup
+	@echo "==> ruff check"
+	$(VENV)/bin/ruff check $(LINT_PATHS)
+	@echo "==> ruff format --check"
+	$(VENV)/bin/ruff format --check $(LINT_PATHS)
+	@echo "==> mypy"
+	$(VENV)/bin/mypy generator
+	@echo "==> pytest"
+	$(VENV_PY) -m pytest $(PYTEST_ARGS)
+
+# --- housekeeping -----------------------------------------------------------------------------
+
+clean:
+	@echo "==> removing build output and caches"
+	find out -mindepth 1 -maxdepth 1 ! -name README.md -exec rm -rf {} +
+	rm -rf build dist .pytest_cache .mypy_cache .ruff_cache bench/results
+	find generator tests -name __pycache__ -type d -prune -exec rm -rf {} +
+	find generator -maxdepth 2 -name '*.egg-info' -type d -prune -exec rm -rf {} +
+
+distclean: clean
+	@echo "==> removing $(VENV) and $(WEB_LAB)/node_modules"
+	rm -rf $(VENV) $(WEB_LAB)/node_modules

@@ -1,0 +1,22 @@
+"""Spec kinds (creature, frost), their pydantic models and the one validation gate."""
+
+from .character import CharacterSpec
+from .errors import SpecError, SpecValidationError
+from .frost import FrostEffectSpec
+from .gate import KINDS, MAX_SPEC_BYTES, Spec, check, load_spec, parse, validate_bytes
+from .types import slugify
+
+__all__ = [
+    "KINDS",
+    "MAX_SPEC_BYTES",
+    "CharacterSpec",
+    "FrostEffectSpec",
+    "Spec",
+    "SpecError",
+    "SpecValidationError",
+    "check",
+    "load_spec",
+    "parse",
+    "slugify",
+    "validate_bytes",
+]
