@@ -7,12 +7,11 @@ so a reviewer reads the whole error vocabulary in one file.
 from __future__ import annotations
 
 import json
-import subprocess
-import sys
 from pathlib import Path
 
 import pytest
 
+from conftest import run_cli
 from creaturegen.spec import MAX_SPEC_BYTES, SpecValidationError, load_spec, validate_bytes
 
 FIXTURES = Path(__file__).parent / "fixtures" / "invalid"
@@ -80,13 +79,7 @@ def test_error_places_follow_ids_not_array_order() -> None:
 
 def test_cli_reports_every_error_and_exits_2(tmp_path: Path) -> None:
     path = FIXTURES / "many-errors-at-once.json"
-    done = subprocess.run(
-        [sys.executable, "-m", "creaturegen.cli", "validate", str(path)],
-        capture_output=True,
-        text=True,
-        check=False,
-        cwd=tmp_path,
-    )
+    done = run_cli("validate", str(path), cwd=tmp_path)
     assert done.returncode == 2
     assert done.stdout == ""
     assert done.stderr.splitlines() == [f"{path}: {line}" for line in EXPECTED["many-errors-at-once"]]
@@ -95,12 +88,7 @@ def test_cli_reports_every_error_and_exits_2(tmp_path: Path) -> None:
 
 def test_cli_json_output_lists_path_and_message() -> None:
     path = FIXTURES / "malformed-json.json"
-    done = subprocess.run(
-        [sys.executable, "-m", "creaturegen.cli", "validate", "--json", str(path)],
-        capture_output=True,
-        text=True,
-        check=False,
-    )
+    done = run_cli("validate", "--json", str(path))
     assert done.returncode == 2
     assert json.loads(done.stdout) == [
         {"file": str(path), "path": "5:3", "message": "invalid JSON: Expecting value"}
@@ -109,31 +97,13 @@ def test_cli_json_output_lists_path_and_message() -> None:
 
 def test_cli_prints_json_syntax_errors_compiler_style() -> None:
     path = FIXTURES / "malformed-json.json"
-    done = subprocess.run(
-        [sys.executable, "-m", "creaturegen.cli", "validate", str(path)],
-        capture_output=True,
-        text=True,
-        check=False,
-    )
+    done = run_cli("validate", str(path))
     assert done.stderr.strip() == f"{path}:5:3: invalid JSON: Expecting value"
 
 
 def test_build_of_an_invalid_spec_writes_nothing(tmp_path: Path) -> None:
     out = tmp_path / "out"
-    done = subprocess.run(
-        [
-            sys.executable,
-            "-m",
-            "creaturegen.cli",
-            "build",
-            str(FIXTURES / "parent-cycle.json"),
-            "-o",
-            str(out),
-        ],
-        capture_output=True,
-        text=True,
-        check=False,
-    )
+    done = run_cli("build", str(FIXTURES / "parent-cycle.json"), "-o", str(out))
     assert done.returncode == 2
     assert "part.body.parent: parent cycle body -> head -> body" in done.stderr
     assert not out.exists()
