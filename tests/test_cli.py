@@ -2,10 +2,16 @@
 
 from __future__ import annotations
 
+import json
 from pathlib import Path
+
+import numpy as np
 
 from conftest import EXAMPLES, REPO, run_cli
 from creaturegen import __version__
+from creaturegen.field.sampler import sample
+from creaturegen.rig import compile_rig
+from creaturegen.spec import CharacterSpec, load_spec
 
 
 def test_version() -> None:
@@ -53,3 +59,45 @@ def test_schema_check_detects_staleness(tmp_path: Path) -> None:
     assert run_cli("schema", "--check", "--out", str(tmp_path)).returncode == 2
     assert run_cli("schema", "--out", str(tmp_path)).returncode == 0
     assert run_cli("schema", "--check", "--out", str(tmp_path)).returncode == 0
+
+
+def test_probe_json_matches_the_sampler(tmp_path: Path) -> None:
+    points = [[0.0, 1.3, 0.2], [0.1, 0.5, -0.3], [0.4, 0.2, 0.1]]
+    path = tmp_path / "points.npy"
+    np.save(path, np.array(points))
+    done = run_cli("probe", str(EXAMPLES / "reference" / "biped.json"), "--points", str(path), "--json")
+    assert done.returncode == 0, done.stderr
+    result = json.loads(done.stdout)
+    spec = load_spec(EXAMPLES / "reference" / "biped.json")
+    assert isinstance(spec, CharacterSpec)
+    expected = sample(compile_rig(spec), np.array(points))
+    assert result["distance"] == expected.distance.tolist()
+    assert result["gradient"] == expected.gradient.tolist()
+    assert result["color"] == expected.color.tolist()
+
+
+def test_probe_rejects_bad_points(tmp_path: Path) -> None:
+    path = tmp_path / "points.json"
+    path.write_text("[[0, 1], [2, 3]]")
+    done = run_cli("probe", str(EXAMPLES / "moth.json"), "--points", str(path))
+    assert done.returncode == 2
+    assert done.stderr.strip() == f"{path}: must be an array of [x, y, z] with finite numbers"
+
+
+def test_probe_of_a_frost_spec_is_refused(tmp_path: Path) -> None:
+    path = tmp_path / "points.json"
+    path.write_text("[[0, 0, 0]]")
+    spec = EXAMPLES / "frost" / "frost-full.json"
+    done = run_cli("probe", str(spec), "--points", str(path))
+    assert done.returncode == 2
+    assert done.stderr.strip() == f"{spec}: kind: must be creature for this command"
+
+
+def test_inspect_json_reports_slots_program_and_signatures() -> None:
+    done = run_cli("inspect", str(EXAMPLES / "beetle.json"), "--json")
+    assert done.returncode == 0, done.stderr
+    report = json.loads(done.stdout)
+    assert report["slotCount"] == len(report["slots"]) == 16
+    assert {op["kernel"] for op in report["blend"]["ops"]} == {"poly", "lse"}
+    assert set(report["signatures"]) == {"compilerSignature", "topologySignature", "geometryDigest"}
+    assert report["compiler"]["floors"]["k_floor"] == 1e-3 * report["bodyScale"]

@@ -12,8 +12,13 @@ import sys
 from collections.abc import Sequence
 from pathlib import Path
 
+import numpy as np
+
 from . import __version__
-from .spec import SpecError, SpecValidationError, load_spec
+from .field.sampler import sample
+from .rig import CompiledRig, RigCompileError, compile_rig
+from .rig.report import describe_rig
+from .spec import CharacterSpec, SpecError, SpecValidationError, load_spec
 from .spec.schema import stale_schemas, write_schemas
 from .spec.summary import summarize
 
@@ -75,6 +80,71 @@ def _build(args: argparse.Namespace) -> int:
     return EXIT_OK
 
 
+def _compiled(name: str) -> CompiledRig | None:
+    """Validate and compile a creature spec, printing every error when that fails."""
+    try:
+        spec = load_spec(Path(name))
+        if not isinstance(spec, CharacterSpec):
+            print(format_error(name, SpecError("kind", "must be creature for this command")), file=sys.stderr)
+            return None
+        return compile_rig(spec)
+    except (SpecValidationError, RigCompileError) as exc:
+        for error in exc.errors:
+            print(format_error(name, error), file=sys.stderr)
+        return None
+
+
+def read_points(path: Path) -> np.ndarray:
+    """Points as a JSON array of [x, y, z] or a .npy of shape (P, 3); ValueError says what is wrong."""
+    try:
+        raw = np.load(path, allow_pickle=False) if path.suffix == ".npy" else json.loads(path.read_text())
+        points = np.asarray(raw, dtype=np.float64)
+    except (OSError, ValueError, TypeError) as exc:
+        raise ValueError(f"cannot read points ({exc})") from exc
+    if points.ndim != 2 or points.shape[1] != 3 or not np.isfinite(points).all():
+        raise ValueError("must be an array of [x, y, z] with finite numbers")
+    return points
+
+
+def _probe(args: argparse.Namespace) -> int:
+    rig = _compiled(args.spec)
+    if rig is None:
+        return EXIT_INVALID
+    try:
+        points = read_points(Path(args.points))
+    except ValueError as exc:
+        print(f"{args.points}: {exc}", file=sys.stderr)
+        return EXIT_INVALID
+    field = sample(rig, points)
+    result = {
+        "distance": field.distance.tolist(),
+        "gradient": field.gradient.tolist(),
+        "color": field.color.tolist(),
+    }
+    if args.json:
+        print(json.dumps(result))
+    else:
+        for p, d, g, c in zip(points, result["distance"], result["gradient"], result["color"], strict=True):
+            print(f"p={p.tolist()} d={d:.9g} grad={[round(x, 9) for x in g]} rgb={[round(x, 6) for x in c]}")
+    return EXIT_OK
+
+
+def _inspect(args: argparse.Namespace) -> int:
+    rig = _compiled(args.spec)
+    if rig is None:
+        return EXIT_INVALID
+    report = describe_rig(rig)
+    if args.json:
+        print(json.dumps(report, indent=2, sort_keys=True))
+        return EXIT_OK
+    print(f"{rig.slot_count} slots, body scale L = {rig.body_scale:.6g} m, {len(rig.graph.ops)} blend ops")
+    for slot in report["slots"]:
+        print(f"  slot {slot['index']:>2} {slot['class']:<9} {slot['kernel']:<15} part {slot['part']}")
+    for name, value in report["signatures"].items():
+        print(f"  {name} {value}")
+    return EXIT_OK
+
+
 def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(
         prog="creaturegen",
@@ -94,6 +164,17 @@ def build_parser() -> argparse.ArgumentParser:
     schema.add_argument("--out", default="schemas", help="folder to write (default: schemas)")
     schema.add_argument("--check", action="store_true", help="exit 2 if the files there are stale")
     schema.set_defaults(run=_schema)
+
+    probe = commands.add_parser("probe", help="evaluate the rest-pose field of a creature at points")
+    probe.add_argument("spec", metavar="SPEC")
+    probe.add_argument("--points", required=True, help="JSON array of [x, y, z] or a .npy of shape (P, 3)")
+    probe.add_argument("--json", action="store_true", help='print {"distance", "gradient", "color"}')
+    probe.set_defaults(run=_probe)
+
+    inspect = commands.add_parser("inspect", help="print slots, the blend program and the signatures")
+    inspect.add_argument("spec", metavar="SPEC")
+    inspect.add_argument("--json", action="store_true", help="machine-readable report")
+    inspect.set_defaults(run=_inspect)
 
     build = commands.add_parser("build", help="validate a spec and build its package into out/<slug>/")
     build.add_argument("spec", metavar="SPEC")
