@@ -141,7 +141,7 @@ def test_every_blend_node_stays_within_its_bound(path: Path) -> None:
     points = _points(rig, 4000, seed=3)
     d_slots, g_slots = primitive_field(rig.slots, points)
     checked = 0
-    for op, value in zip(rig.graph.ops, evaluate_ops(rig, d_slots, g_slots), strict=True):
+    for op, value in zip(rig.graph.ops, evaluate_ops(rig.graph, d_slots, g_slots), strict=True):
         low = value.operands.min(axis=0)
         depth = op.k / 4 if op.kernel == "poly" else op.k * math.log(len(op.children))
         slack = 1e-12 * rig.body_scale

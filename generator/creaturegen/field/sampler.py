@@ -13,7 +13,7 @@ import numpy as np
 import numpy.typing as npt
 
 from ..rig import CompiledRig
-from ..rig.graph import Ref
+from ..rig.graph import BlendGraph, Ref
 from . import layout as col
 from .blend import hard_min, lse_smin, poly_smin
 from .colour import proximity_colour
@@ -40,7 +40,7 @@ class OpValue:
     blend: Array  # poly: h (P,); lse: softmax weights (N, P)
 
 
-def evaluate_ops(rig: CompiledRig, d_slots: Array, g_slots: Array) -> list[OpValue]:
+def evaluate_ops(graph: BlendGraph, d_slots: Array, g_slots: Array) -> list[OpValue]:
     """Every op of the program in order; children are always evaluated before their parent."""
     values: list[OpValue] = []
 
@@ -49,7 +49,7 @@ def evaluate_ops(rig: CompiledRig, d_slots: Array, g_slots: Array) -> list[OpVal
             return d_slots[ref.index], g_slots[ref.index]
         return values[ref.index].distance, values[ref.index].gradient
 
-    for op in rig.graph.ops:
+    for op in graph.ops:
         members = [get(c) for c in op.children]
         ds = np.stack([m[0] for m in members])
         if op.kernel == "poly":
@@ -61,25 +61,35 @@ def evaluate_ops(rig: CompiledRig, d_slots: Array, g_slots: Array) -> list[OpVal
     return values
 
 
-def evaluate_graph(rig: CompiledRig, d_slots: Array, g_slots: Array) -> tuple[Array, Array]:
-    """The body's distance and gradient: the ops, then the roots by hard min."""
-    values = evaluate_ops(rig, d_slots, g_slots)
-    roots = [
-        (d_slots[r.index], g_slots[r.index])
-        if r.kind == "slot"
-        else (values[r.index].distance, values[r.index].gradient)
-        for r in rig.graph.roots
-    ]
-    d, g, _ = hard_min(np.stack([r[0] for r in roots]), np.stack([r[1] for r in roots]))
+def evaluate_graph(graph: BlendGraph, d_slots: Array, g_slots: Array) -> tuple[Array, Array]:
+    """The body's distance and gradient: the ops, then the roots by hard min.
+
+    ``d_slots``/``g_slots`` are indexed by the graph's slot refs; a candidate program passes only its
+    kept leaves, renumbered.
+    """
+    values = evaluate_ops(graph, d_slots, g_slots)
+    ds = [d_slots[r.index] if r.kind == "slot" else values[r.index].distance for r in graph.roots]
+    gs = [g_slots[r.index] if r.kind == "slot" else values[r.index].gradient for r in graph.roots]
+    d, g, _ = hard_min(np.stack(ds), np.stack(gs))
     return d, g
+
+
+def sample_graph(
+    graph: BlendGraph,
+    slots: npt.NDArray[np.float64],
+    points: npt.ArrayLike,
+    k_floor: float,
+    dtype: type[np.floating] = np.float64,
+) -> FieldSample:
+    """Evaluate any program over the slot rows it indexes (a full rig, or a candidate's kept leaves)."""
+    p = np.asarray(points, dtype=dtype).reshape(-1, 3)
+    table = slots.astype(dtype)
+    d_slots, g_slots = primitive_field(table, p, dtype=dtype)
+    distance, gradient = evaluate_graph(graph, d_slots, g_slots)
+    color = proximity_colour(d_slots, table[:, col.K], table[:, col.RGB], k_floor)
+    return FieldSample(distance, gradient, color)
 
 
 def sample(rig: CompiledRig, points: npt.ArrayLike, dtype: type[np.floating] = np.float64) -> FieldSample:
     """Evaluate the rest-pose field at points of shape (P, 3)."""
-    p = np.asarray(points, dtype=dtype).reshape(-1, 3)
-    slots = rig.slots.astype(dtype)
-    d_slots, g_slots = primitive_field(slots, p, dtype=dtype)
-    distance, gradient = evaluate_graph(rig, d_slots, g_slots)
-    floors = floors_for(rig.body_scale)
-    color = proximity_colour(d_slots, slots[:, col.K], slots[:, col.RGB], floors.k_floor)
-    return FieldSample(distance, gradient, color)
+    return sample_graph(rig.graph, rig.slots, points, floors_for(rig.body_scale).k_floor, dtype)
