@@ -1,0 +1,92 @@
+"""Candidate programs: per-region bounded evaluation of the body field, with certificates and a sweep."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+from ..field.floors import floors_for
+from ..rig import CompiledRig
+from ..spec import CharacterSpec
+from .envelope import part_excursions, slot_excursions
+from .program import CandidateProgram, Certificate
+from .regions import TIERS, Tier, TierRejectedError, Tolerances, search
+from .sweep import SweepResult, run_sweep
+
+#: Band τ around the surface that programs must reproduce, as a fraction of the body size L.
+BAND_FACTOR = 0.02
+#: Accepted n-ary tail bound and sweep surface error, as a fraction of L.
+TAIL_FACTOR = 1e-5
+#: Accepted normal angle and OKLab colour distance between a program and the full graph.
+MAX_NORMAL_ANGLE_DEG = 0.05
+MAX_DELTA_E_OKLAB = 0.002
+
+__all__ = [
+    "TIERS",
+    "CandidateProgram",
+    "CandidateSet",
+    "Certificate",
+    "TierRejectedError",
+    "build_candidates",
+]
+
+
+@dataclass(frozen=True)
+class Gate:
+    name: str
+    value: float
+    unit: str
+    threshold: float
+
+    @property
+    def passed(self) -> bool:
+        return self.value <= self.threshold
+
+
+@dataclass(frozen=True)
+class CandidateSet:
+    tier: Tier
+    k_used: int  # most leaves any region keeps: the bound of the runtime's dynamic loop
+    programs: tuple[CandidateProgram, ...]
+    skipped_outside: int
+    skipped_inside: int
+    sweep: SweepResult
+    gates: tuple[Gate, ...] = field(default=())
+
+    @property
+    def certificate_count(self) -> int:
+        return sum(len(p.certificates) for p in self.programs)
+
+
+def tolerances(rig: CompiledRig) -> Tolerances:
+    floors = floors_for(rig.body_scale)
+    return Tolerances(
+        band=BAND_FACTOR * rig.body_scale,
+        tail=TAIL_FACTOR * rig.body_scale,
+        weight_floor=floors.weight_floor,
+        k_floor=floors.k_floor,
+    )
+
+
+def build_candidates(spec: CharacterSpec, rig: CompiledRig, tier: str) -> CandidateSet:
+    """Programs for every region, certified and swept; TierRejectedError names what could not be bounded."""
+    chosen = TIERS[tier]
+    tol = tolerances(rig)
+    found = search(rig, slot_excursions(spec, rig), chosen, tol)
+    programs = found.programs
+    result = run_sweep(rig, programs, part_excursions(spec), tol.band, tol.k_floor)
+    gates = (
+        Gate("surfaceError", result.surface_error, "m", tol.tail),
+        Gate("normalAngle", result.normal_angle_deg, "deg", MAX_NORMAL_ANGLE_DEG),
+        Gate("omittedColourWeight", result.omitted_colour_weight, "1", tol.weight_floor),
+        Gate("deltaEOklab", result.delta_e_oklab, "1", MAX_DELTA_E_OKLAB),
+    )
+    failed = [g for g in gates if not g.passed]
+    if failed:
+        g = failed[0]
+        raise TierRejectedError(
+            f"tier {tier}: sweep gate {g.name} = {g.value:.4g} {g.unit} exceeds {g.threshold:.4g}"
+        )
+    k_used = max((len(p.leaves) for p in programs), default=0)
+    return CandidateSet(
+        chosen, k_used, tuple(programs), found.skipped_outside, found.skipped_inside, result, gates
+    )

@@ -1,0 +1,102 @@
+"""Acceptance sweep: candidate programs against the full graph over sampled envelope poses.
+
+Certificates prove what they can; the sweep measures what a user would see. Each pose translates every
+part rigidly by a random vector inside its envelope ball (the same envelope the certificates assume).
+Sample points start uniform in each region and take two Newton steps toward the full field's zero set;
+points that leave their region or the band τ are dropped. Measured per point: |Δd|, the angle between
+the normals, the omitted leaves' share of the colour weight, and the OKLab distance of the colours.
+All regions are sampled together and each distinct program is evaluated once over all its regions.
+"""
+
+from __future__ import annotations
+
+from collections import defaultdict
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..field import layout as col
+from ..field.colour import proximity_weights
+from ..field.primitives import primitive_field
+from ..field.sampler import sample_graph
+from ..rig import CompiledRig
+from ..rig.colour import linear_to_oklab
+from ..rig.graph import BlendGraph
+from .program import CandidateProgram
+
+
+@dataclass(frozen=True)
+class SweepResult:
+    poses: int
+    points: int  # in-band samples evaluated, all poses together
+    surface_error: float  # max |d_program − d_full|, m
+    normal_angle_deg: float
+    omitted_colour_weight: float  # max share of the colour weight held by omitted leaves
+    delta_e_oklab: float
+
+
+def _pose(rig: CompiledRig, part_excursion: dict[str, float], rng: np.random.Generator) -> np.ndarray:
+    slots = rig.slots.copy()
+    for part in sorted(set(rig.slot_parts)):
+        rows = [i for i, p in enumerate(rig.slot_parts) if p == part]
+        direction = rng.normal(size=3)
+        direction /= np.linalg.norm(direction)
+        shift = direction * part_excursion[part] * rng.uniform() ** (1 / 3)
+        slots[rows, col.A] += shift
+        slots[rows, col.B] += shift
+    return slots
+
+
+def _groups(programs: list[CandidateProgram]) -> dict[tuple[tuple[int, ...], BlendGraph], list[int]]:
+    """Regions sharing one program (same leaves, same pruned graph)."""
+    groups: dict[tuple[tuple[int, ...], BlendGraph], list[int]] = defaultdict(list)
+    for i, program in enumerate(programs):
+        groups[(program.leaves, program.graph)].append(i)
+    return groups
+
+
+def run_sweep(
+    rig: CompiledRig,
+    programs: list[CandidateProgram],
+    part_excursion: dict[str, float],
+    band: float,
+    k_floor: float,
+    poses: int = 6,
+    points_per_region: int = 32,
+    seed: int = 20261121,
+) -> SweepResult:
+    rng = np.random.default_rng(seed)
+    lo = np.array([p.lo for p in programs]).reshape(-1, 3)
+    hi = np.array([p.hi for p in programs]).reshape(-1, 3)
+    region = np.repeat(np.arange(len(programs)), points_per_region)
+    groups = _groups(programs)
+    worst = np.zeros(4)
+    total = 0
+    for pose in range(poses + 1):
+        slots = rig.slots if pose == 0 else _pose(rig, part_excursion, rng)
+        p = rng.uniform(lo[region], hi[region])
+        for _ in range(2):
+            f = sample_graph(rig.graph, slots, p, k_floor)
+            g2 = np.maximum((f.gradient**2).sum(axis=1), 1e-30)
+            p = p - (f.distance / g2)[:, None] * f.gradient
+        full = sample_graph(rig.graph, slots, p, k_floor)
+        inside = (p >= lo[region]).all(axis=1) & (p <= hi[region]).all(axis=1)
+        keep = inside & (np.abs(full.distance) <= band)
+        d_slots, _ = primitive_field(slots, p)
+        weights = proximity_weights(d_slots, slots[:, col.K], k_floor)
+        for (leaves, graph), members in groups.items():
+            idx = np.flatnonzero(keep & np.isin(region, members))
+            if len(idx) == 0:
+                continue
+            total += len(idx)
+            mine = sample_graph(graph, slots[list(leaves)], p[idx], k_floor)
+            n_full = full.gradient[idx] / np.linalg.norm(full.gradient[idx], axis=1, keepdims=True)
+            n_mine = mine.gradient / np.linalg.norm(mine.gradient, axis=1, keepdims=True)
+            angle = np.degrees(np.arccos(np.clip((n_full * n_mine).sum(axis=1), -1.0, 1.0)))
+            w = weights[:, idx]
+            omitted = np.setdiff1d(np.arange(len(slots)), leaves)
+            share = w[omitted].sum(axis=0) / w.sum(axis=0)
+            delta_e = np.linalg.norm(linear_to_oklab(full.color[idx]) - linear_to_oklab(mine.color), axis=1)
+            error = np.abs(mine.distance - full.distance[idx])
+            worst = np.maximum(worst, [error.max(), angle.max(), share.max(), delta_e.max()])
+    return SweepResult(poses, total, *(float(x) for x in worst))

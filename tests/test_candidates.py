@@ -1,0 +1,154 @@
+"""Candidate programs: certified omissions, the envelope sweep, growing K and rejecting tiers."""
+
+from __future__ import annotations
+
+import json
+from functools import cache
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from conftest import EXAMPLES
+from creaturegen.candidates import CandidateSet, TierRejectedError, build_candidates, tolerances
+from creaturegen.candidates.bounds import leaf_bounds, subtree_info
+from creaturegen.candidates.envelope import part_excursions, slot_excursions
+from creaturegen.candidates.program import build_program
+from creaturegen.field.floors import floors_for
+from creaturegen.field.sampler import sample_graph
+from creaturegen.rig import CompiledRig, compile_rig
+from creaturegen.spec import CharacterSpec, load_spec, validate_bytes
+
+CREATURES = [p for p in sorted(EXAMPLES.rglob("*.json")) if "frost" not in p.parts]
+
+
+@cache
+def _compiled(path: Path) -> tuple[CharacterSpec, CompiledRig]:
+    spec = load_spec(path)
+    assert isinstance(spec, CharacterSpec)
+    return spec, compile_rig(spec)
+
+
+@cache
+def _hero(path: Path) -> CandidateSet:
+    spec, rig = _compiled(path)
+    return build_candidates(spec, rig, "hero")
+
+
+@pytest.mark.parametrize("path", CREATURES, ids=lambda p: p.name)
+def test_hero_programs_are_certified_and_pass_the_sweep(path: Path) -> None:
+    _, rig = _compiled(path)
+    found = _hero(path)
+    assert found.programs, "every body has surface regions"
+    assert all(p.certified for p in found.programs)
+    assert found.k_used == max(len(p.leaves) for p in found.programs) <= rig.slot_count
+    assert found.sweep.points >= 1000
+    for gate in found.gates:
+        assert gate.passed, gate
+
+
+def test_an_uncertified_omission_is_flagged_and_really_changes_the_field() -> None:
+    """Certificates are not decoration: drop a leaf that touches the region and both the certificate and
+    the measured field disagree with the full graph."""
+    spec, rig = _compiled(EXAMPLES / "reference" / "biped.json")
+    head = rig.slot_parts.index("head")
+    centre = rig.slots[head, 0:3]
+    lo, hi = centre - 0.1, centre + 0.1
+    excursion = slot_excursions(spec, rig)
+    bounds = leaf_bounds(rig.slots, excursion, lo, hi)
+    tol = tolerances(rig)
+    kept = set(range(rig.slot_count)) - {head}
+    program = build_program(
+        rig.graph,
+        subtree_info(rig.graph),
+        bounds,
+        rig.slots,
+        kept,
+        (lo, hi),
+        tol.band,
+        tol.tail,
+        tol.weight_floor,
+        tol.k_floor,
+    )
+    failing = [c for c in program.certificates if not c.holds]
+    assert {c.kind for c in failing} >= {"poly-saturation", "colour-weight"}
+    points = centre + np.array([[0.0, 0.16, 0.0], [0.16, 0.0, 0.0], [0.0, 0.0, 0.16]])
+    full = sample_graph(rig.graph, rig.slots, points, tol.k_floor)
+    mine = sample_graph(program.graph, rig.slots[list(program.leaves)], points, tol.k_floor)
+    assert np.abs(full.distance - mine.distance).min() > 0.05
+
+
+def test_certified_programs_are_bit_exact_for_polynomial_trees() -> None:
+    """A saturation certificate means h clamps to 0: the program returns the kept child bit for bit."""
+    _, rig = _compiled(EXAMPLES / "reference" / "quadruped.json")
+    found = _hero(EXAMPLES / "reference" / "quadruped.json")
+    rng = np.random.default_rng(5)
+    k_floor = floors_for(rig.body_scale).k_floor
+    checked = 0
+    for program in found.programs:
+        p = rng.uniform(program.lo, program.hi, size=(64, 3))
+        full = sample_graph(rig.graph, rig.slots, p, k_floor)
+        band = np.abs(full.distance) <= tolerances(rig).band
+        mine = sample_graph(program.graph, rig.slots[list(program.leaves)], p, k_floor)
+        assert np.array_equal(mine.distance[band], full.distance[band])
+        checked += int(band.sum())
+    assert checked > 100
+
+
+def test_lse_tail_bounds_cover_the_measured_error() -> None:
+    found = _hero(EXAMPLES / "beetle.json")
+    tails = [c for p in found.programs for c in p.certificates if c.kind == "lse-tail"]
+    assert tails, "the beetle's n-ary groups are pruned somewhere"
+    assert found.sweep.surface_error <= max(c.value for c in tails) + 1e-15
+    assert found.sweep.surface_error > 0  # the tail is real, not zero
+
+
+def test_small_tiers_are_rejected_with_the_region_and_omission_named() -> None:
+    spec, rig = _compiled(EXAMPLES / "reference" / "quadruped.json")
+    with pytest.raises(
+        TierRejectedError, match=r"^tier distant: region \[.*\] needs more than K = 4 leaves: "
+    ):
+        build_candidates(spec, rig, "distant")
+
+
+def test_a_rigid_creature_fits_the_distant_tier() -> None:
+    spec, rig = _compiled(EXAMPLES / "reference" / "flyer.json")
+    found = build_candidates(spec, rig, "distant")
+    assert found.k_used <= 4
+
+
+def test_envelope_follows_declared_excursions_and_parents() -> None:
+    data = {
+        "name": "Env",
+        "parts": [
+            {"id": "body", "shape": "capsule", "a": [0, 0.5, 0], "b": [0, 0.9, 0], "r": 0.2},
+            {
+                "id": "leg",
+                "shape": "leg",
+                "parent": "body",
+                "hip": [0.1, 0, 0],
+                "upper": 0.3,
+                "lower": 0.2,
+                "r": 0.05,
+            },
+            {
+                "id": "wing",
+                "shape": "cone",
+                "parent": "body",
+                "a": [0.1, 0.2, 0],
+                "b": [0.5, 0.2, 0],
+                "r": 0.05,
+                "r2": 0.02,
+                "flap": 0.5,
+            },
+            {"id": "tuft", "shape": "sphere", "parent": "wing", "offset": [0.4, 0, 0], "r": 0.03},
+        ],
+        "scale": 2,
+    }
+    spec = validate_bytes(json.dumps(data).encode())
+    assert isinstance(spec, CharacterSpec)
+    e = part_excursions(spec)
+    assert e["body"] == 0.0
+    assert e["leg"] == pytest.approx(2 * 0.5)
+    assert e["wing"] == pytest.approx(2 * 2 * 0.4 * np.sin(0.25))
+    assert e["tuft"] == e["wing"]  # children ride on their parent
