@@ -94,10 +94,20 @@ def test_probe_of_a_frost_spec_is_refused(tmp_path: Path) -> None:
 
 
 def test_inspect_json_reports_slots_program_and_signatures() -> None:
-    done = run_cli("inspect", str(EXAMPLES / "beetle.json"), "--json")
+    done = run_cli("inspect", str(EXAMPLES / "beetle.json"), "--json", "--tiers", "hero")
     assert done.returncode == 0, done.stderr
     report = json.loads(done.stdout)
+    hero = report["candidates"]["hero"]
+    assert hero["status"] == "accepted"
+    assert all(g["passed"] for g in hero["gates"])
+    assert set(hero["certificates"]) >= {"lse-tail", "colour-weight"}
     assert report["slotCount"] == len(report["slots"]) == 16
     assert {op["kernel"] for op in report["blend"]["ops"]} == {"poly", "lse"}
     assert set(report["signatures"]) == {"compilerSignature", "topologySignature", "geometryDigest"}
     assert report["compiler"]["floors"]["k_floor"] == 1e-3 * report["bodyScale"]
+
+
+def test_inspect_rejects_an_unknown_tier() -> None:
+    done = run_cli("inspect", str(EXAMPLES / "moth.json"), "--tiers", "hero,epic")
+    assert done.returncode == 2
+    assert done.stderr.strip() == "--tiers: unknown tier 'epic' (known: hero, repeated, distant)"

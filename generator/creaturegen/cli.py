@@ -15,6 +15,7 @@ from pathlib import Path
 import numpy as np
 
 from . import __version__
+from .candidates import TIERS, describe_candidates
 from .field.sampler import sample
 from .rig import CompiledRig, RigCompileError, compile_rig
 from .rig.report import describe_rig
@@ -80,14 +81,14 @@ def _build(args: argparse.Namespace) -> int:
     return EXIT_OK
 
 
-def _compiled(name: str) -> CompiledRig | None:
+def _compiled(name: str) -> tuple[CharacterSpec, CompiledRig] | None:
     """Validate and compile a creature spec, printing every error when that fails."""
     try:
         spec = load_spec(Path(name))
         if not isinstance(spec, CharacterSpec):
             print(format_error(name, SpecError("kind", "must be creature for this command")), file=sys.stderr)
             return None
-        return compile_rig(spec)
+        return spec, compile_rig(spec)
     except (SpecValidationError, RigCompileError) as exc:
         for error in exc.errors:
             print(format_error(name, error), file=sys.stderr)
@@ -107,9 +108,10 @@ def read_points(path: Path) -> np.ndarray:
 
 
 def _probe(args: argparse.Namespace) -> int:
-    rig = _compiled(args.spec)
-    if rig is None:
+    compiled = _compiled(args.spec)
+    if compiled is None:
         return EXIT_INVALID
+    rig = compiled[1]
     try:
         points = read_points(Path(args.points))
     except ValueError as exc:
@@ -130,10 +132,18 @@ def _probe(args: argparse.Namespace) -> int:
 
 
 def _inspect(args: argparse.Namespace) -> int:
-    rig = _compiled(args.spec)
-    if rig is None:
+    compiled = _compiled(args.spec)
+    if compiled is None:
         return EXIT_INVALID
+    spec, rig = compiled
     report = describe_rig(rig)
+    tiers = tuple(t for t in args.tiers.split(",") if t)
+    unknown = [t for t in tiers if t not in TIERS]
+    if unknown:
+        print(f"--tiers: unknown tier {unknown[0]!r} (known: {', '.join(TIERS)})", file=sys.stderr)
+        return EXIT_INVALID
+    print(f"==> candidate programs for tiers {', '.join(tiers)}", file=sys.stderr)
+    report["candidates"] = describe_candidates(spec, rig, tiers)
     if args.json:
         print(json.dumps(report, indent=2, sort_keys=True))
         return EXIT_OK
@@ -142,6 +152,16 @@ def _inspect(args: argparse.Namespace) -> int:
         print(f"  slot {slot['index']:>2} {slot['class']:<9} {slot['kernel']:<15} part {slot['part']}")
     for name, value in report["signatures"].items():
         print(f"  {name} {value}")
+    for tier, summary in report["candidates"].items():
+        if summary["status"] == "rejected":
+            print(f"  candidates {tier}: rejected: {summary['reason']}")
+        else:
+            print(
+                f"  candidates {tier}: K = {summary['kUsed']} (authored {summary['kAuthored']}), "
+                f"{summary['regions']} regions, {summary['distinctPrograms']} distinct programs, "
+                f"sweep {summary['sweep']['points']} points: "
+                + ", ".join(f"{g['name']} {g['value']:.3g}/{g['threshold']:.3g}" for g in summary["gates"])
+            )
     return EXIT_OK
 
 
@@ -174,6 +194,9 @@ def build_parser() -> argparse.ArgumentParser:
     inspect = commands.add_parser("inspect", help="print slots, the blend program and the signatures")
     inspect.add_argument("spec", metavar="SPEC")
     inspect.add_argument("--json", action="store_true", help="machine-readable report")
+    inspect.add_argument(
+        "--tiers", default=",".join(TIERS), help="candidate tiers to build (default: hero,repeated,distant)"
+    )
     inspect.set_defaults(run=_inspect)
 
     build = commands.add_parser("build", help="validate a spec and build its package into out/<slug>/")

@@ -27,6 +27,7 @@ __all__ = [
     "Certificate",
     "TierRejectedError",
     "build_candidates",
+    "describe_candidates",
 ]
 
 
@@ -90,3 +91,40 @@ def build_candidates(spec: CharacterSpec, rig: CompiledRig, tier: str) -> Candid
     return CandidateSet(
         chosen, k_used, tuple(programs), found.skipped_outside, found.skipped_inside, result, gates
     )
+
+
+def describe_candidates(spec: CharacterSpec, rig: CompiledRig, tiers: tuple[str, ...]) -> dict[str, object]:
+    """Per tier: accepted with its K, regions, certificates and sweep gates, or rejected with the reason."""
+    out: dict[str, object] = {}
+    for name in tiers:
+        try:
+            found = build_candidates(spec, rig, name)
+        except TierRejectedError as exc:
+            out[name] = {"status": "rejected", "reason": str(exc)}
+            continue
+        kinds: dict[str, int] = {}
+        for program in found.programs:
+            for cert in program.certificates:
+                kinds[cert.kind] = kinds.get(cert.kind, 0) + 1
+        out[name] = {
+            "status": "accepted",
+            "kAuthored": found.tier.k,
+            "kUsed": found.k_used,
+            "regions": len(found.programs),
+            "distinctPrograms": len({(p.leaves, p.graph) for p in found.programs}),
+            "skippedOutside": found.skipped_outside,
+            "skippedInside": found.skipped_inside,
+            "certificates": kinds,
+            "sweep": {"poses": found.sweep.poses, "points": found.sweep.points},
+            "gates": [
+                {
+                    "name": g.name,
+                    "value": g.value,
+                    "unit": g.unit,
+                    "threshold": g.threshold,
+                    "passed": g.passed,
+                }
+                for g in found.gates
+            ],
+        }
+    return out
