@@ -22,7 +22,7 @@ PYTEST_ARGS ?=
 # Only folders that exist: git does not keep empty ones, and ruff fails on a missing path.
 LINT_PATHS := $(wildcard generator tests bench)
 
-.PHONY: help setup system-deps build test schemas lab clean distclean
+.PHONY: help setup system-deps build test schemas lab bench clean distclean
 
 help:
 	@echo "make setup    .venv + pip install -e '.[dev]', npm ci in $(WEB_LAB), chromium + lavapipe"
@@ -30,6 +30,7 @@ help:
 	@echo "make test     ruff, ruff format --check, mypy, pytest (browser tests included)"
 	@echo "make schemas  export JSON Schemas into schemas/"
 	@echo "make lab      serve $(WEB_LAB)/ at http://$(LAB_HOST):$(LAB_PORT)/"
+	@echo "make bench    field benchmark (full graph vs candidates, analytic vs FD) into bench/results/field.json"
 	@echo "make clean    remove build output and caches; distclean also removes .venv and node_modules"
 
 # --- setup ------------------------------------------------------------------------------------
@@ -69,6 +70,10 @@ schemas: $(VENV_STAMP)
 
 lab: $(VENV_STAMP) $(NODE_STAMP)
 	$(VENV_PY) -m creaturegen.lab.server --root $(WEB_LAB) --host $(LAB_HOST) --port $(LAB_PORT)
+
+bench: $(VENV_STAMP)
+	@echo "==> field benchmark into bench/results/field.json"
+	$(VENV_PY) bench/field.py --out bench/results/field.json
 
 # --- checks -----------------------------------------------------------------------------------
 
