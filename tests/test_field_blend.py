@@ -8,8 +8,12 @@ import numpy as np
 import numpy.typing as npt
 import pytest
 
+from conftest import EXAMPLES
 from creaturegen.field.blend import hard_min, lse_smin, lse_tail_bound, poly_smin
-from creaturegen.field.primitives import primitive_field
+from creaturegen.field.primitives import primitive_distance, primitive_field
+from creaturegen.field.sampler import sample, sample_distance
+from creaturegen.rig import compile_rig
+from creaturegen.spec import CharacterSpec, load_spec
 from test_field_primitives import EPSILON_DECADES, central_difference_sweep, make_slots
 
 Array = npt.NDArray[Any]
@@ -175,3 +179,19 @@ def test_float32_blends_stay_float32_even_with_a_float64_width() -> None:
     assert all(x.dtype == np.float32 for x in outs)
     d, g, _ = hard_min(ds, gs)
     assert d.dtype == g.dtype == np.float32
+
+
+def test_distance_only_path_is_bit_identical_to_the_sampler() -> None:
+    """The central-difference taps and the benchmark use the distance-only path; it must be the same
+    arithmetic as the sampler's distance, on both primitive forms, both blend kernels and several roots."""
+    rng = np.random.default_rng(11)
+    for name in ("beetle.json", "moth.json", "reference/hexapod.json"):
+        spec = load_spec(EXAMPLES / name)
+        assert isinstance(spec, CharacterSpec)
+        rig = compile_rig(spec)
+        points = rng.uniform(-1.0, 1.5, size=(2000, 3))
+        for dtype in (np.float64, np.float32):
+            d_field, _ = primitive_field(rig.slots, points, dtype=dtype)
+            assert np.array_equal(primitive_distance(rig.slots, points, dtype=dtype), d_field)
+            full = sample(rig, points, dtype=dtype)
+            assert np.array_equal(sample_distance(rig.graph, rig.slots, points, dtype=dtype), full.distance)

@@ -36,6 +36,11 @@ def format_error(source: str, error: SpecError) -> str:
     return f"{source}: {error.path}: {error.message}"
 
 
+def print_errors(source: str, errors: list[SpecError]) -> None:
+    for error in errors:
+        print(format_error(source, error), file=sys.stderr)
+
+
 def _validate(args: argparse.Namespace) -> int:
     failures: list[dict[str, str]] = []
     for name in args.specs:
@@ -44,8 +49,7 @@ def _validate(args: argparse.Namespace) -> int:
         except SpecValidationError as exc:
             failures += [{"file": name, **e.as_dict()} for e in exc.errors]
             if not args.json:
-                for error in exc.errors:
-                    print(format_error(name, error), file=sys.stderr)
+                print_errors(name, exc.errors)
             continue
         if not args.json:
             print(f"{name}: ok")
@@ -72,8 +76,7 @@ def _build(args: argparse.Namespace) -> int:
     try:
         spec = load_spec(Path(args.spec))
     except SpecValidationError as exc:
-        for error in exc.errors:
-            print(format_error(args.spec, error), file=sys.stderr)
+        print_errors(args.spec, exc.errors)
         return EXIT_INVALID
     print(f"{args.spec}: ok")
     print("\n".join(summarize(spec)))
@@ -86,12 +89,11 @@ def _compiled(name: str) -> tuple[CharacterSpec, CompiledRig] | None:
     try:
         spec = load_spec(Path(name))
         if not isinstance(spec, CharacterSpec):
-            print(format_error(name, SpecError("kind", "must be creature for this command")), file=sys.stderr)
+            print_errors(name, [SpecError("kind", "must be creature for this command")])
             return None
         return spec, compile_rig(spec)
     except (SpecValidationError, RigCompileError) as exc:
-        for error in exc.errors:
-            print(format_error(name, error), file=sys.stderr)
+        print_errors(name, exc.errors)
         return None
 
 

@@ -32,12 +32,19 @@ def poly_smin(
     saturated ``h`` of exactly 0 or 1 returns the child's distance and gradient bit for bit.
     ``k`` must be positive; a zero width is a hard min and belongs to ``hard_min``.
     """
+    d, h = poly_smin_distance(dl, dr, k)
+    one_minus_h = 1.0 - h
+    g = gl * one_minus_h[..., None] + gr * h[..., None]
+    return d, g, h
+
+
+def poly_smin_distance(dl: FloatArray, dr: FloatArray, k: Width) -> tuple[FloatArray, FloatArray]:
+    """``poly_smin``'s distance and ``h`` alone (bit-identical to it), for distance-only evaluation."""
     width = _positive_width(k)
     h = np.clip(0.5 + 0.5 * (dl - dr) / width, 0.0, 1.0)
     one_minus_h = 1.0 - h
-    d = dl * one_minus_h + dr * h - width * h * one_minus_h
-    g = gl * one_minus_h[..., None] + gr * h[..., None]
-    return d, g, h
+    d: FloatArray = dl * one_minus_h + dr * h - width * h * one_minus_h
+    return d, h
 
 
 def lse_smin(ds: FloatArray, gs: FloatArray, k: Width) -> tuple[FloatArray, FloatArray, FloatArray]:
@@ -57,16 +64,22 @@ def lse_smin(ds: FloatArray, gs: FloatArray, k: Width) -> tuple[FloatArray, Floa
     Tail: the sum is monotone in its members, so dropping members whose terms sum to at most ``B`` from
     a kept sum ``A`` raises ``d`` by at most ``k·log(1 + B/A)``; see ``lse_tail_bound``.
     """
-    width = _positive_width(k)
     if ds.ndim != 2 or gs.shape != (*ds.shape, 3):
         raise ValueError(f"lse_smin: expected ds (N, P) and gs (N, P, 3) (got {ds.shape}, {gs.shape})")
+    d, w = lse_smin_distance(ds, k)
+    g = (w[..., None] * gs).sum(axis=0)
+    return d, g, w
+
+
+def lse_smin_distance(ds: FloatArray, k: Width) -> tuple[FloatArray, FloatArray]:
+    """``lse_smin``'s distance and weights alone (bit-identical to it), for distance-only evaluation."""
+    width = _positive_width(k)
     m = ds.min(axis=0)
     terms = np.exp(-(ds - m) / width)
     total = terms.sum(axis=0)
-    d = m - width * np.log(total)
-    w = terms / total
-    g = (w[..., None] * gs).sum(axis=0)
-    return d, g, w
+    d: FloatArray = m - width * np.log(total)
+    w: FloatArray = terms / total
+    return d, w
 
 
 def lse_tail_bound(

@@ -18,7 +18,8 @@ the GPU path rather than a float64 result cast down at the end.
 
 from __future__ import annotations
 
-from typing import Any, TypeAlias
+from functools import cached_property
+from typing import Any, NamedTuple, TypeAlias
 
 import numpy as np
 import numpy.typing as npt
@@ -82,6 +83,23 @@ def primitive_field(
     return d, g
 
 
+def primitive_distance(
+    slots: FloatArray, points: FloatArray, dtype: npt.DTypeLike = np.float64
+) -> FloatArray:
+    """Distance only, shape (S, P): the same forms and arithmetic as ``primitive_field`` (bit-identical
+    distances), without the gradient work. Central-difference verification taps and benchmarks use it."""
+    table = _check_slots(slots)
+    pts = _check_points(points)
+    dt = _float_dtype(dtype)
+    round_cone = slot_uses_round_cone(table)
+    d = np.empty((table.shape[0], pts.shape[0]), dtype=dt)
+    if (~round_cone).any():
+        d[~round_cone] = _tapered_distance(_Frame(table[~round_cone], pts, dt, GRADIENT_FLOOR)).d
+    if round_cone.any():
+        d[round_cone] = _round_cone_distance(_Frame(table[round_cone], pts, dt, GRADIENT_FLOOR)).d
+    return d
+
+
 def tapered_capsule_field(
     slots: FloatArray,
     points: FloatArray,
@@ -96,10 +114,7 @@ def tapered_capsule_field(
     end point. A sphere is the zero-length case: ``t = 0``, radial from ``a``.
     """
     fr = _Frame(_check_slots(slots), _check_points(points), _float_dtype(dtype), gradient_floor)
-    t = np.clip(fr.t_raw, 0.0, 1.0)
-    q = fr.pa - fr.ba * t[..., None]
-    q_len = _norm(q)
-    d = q_len - (fr.ra + (fr.rb - fr.ra) * t)
+    d, q, q_len = _tapered_distance(fr)
     # Strict inequalities: on the seams t is unchanged by the clamp, so the side formula holds there as
     # a one-sided derivative, and an axis point at t = 0 falls back like the round cone's side does.
     below, above = fr.t_raw < 0.0, fr.t_raw > 1.0
@@ -130,6 +145,45 @@ def round_cone_field(
     exactly, since ``√(L·L) = L`` in IEEE arithmetic) both return bit-identical results.
     """
     fr = _Frame(_check_slots(slots), _check_points(points), _float_dtype(dtype), gradient_floor)
+    d, q, x, sn, c, pb, pa_len, pb_len, cap_a, cap_b = _round_cone_distance(fr)
+    g_a = _unit(fr.pa, pa_len, fr.floor, -fr.axis)
+    g_b = _unit(pb, pb_len, fr.floor, fr.axis)
+    g_side = c[..., None] * _unit(q, x, fr.floor, fr.perpendicular) + sn[..., None] * fr.axis
+    g = np.where(cap_a[..., None], g_a, np.where(cap_b[..., None], g_b, g_side))
+    return d, g
+
+
+class _TaperedCore(NamedTuple):
+    """The tapered form's distance and the radial vector its gradient reuses."""
+
+    d: FloatArray
+    q: FloatArray
+    x: FloatArray  # |q|
+
+
+class _ConeCore(NamedTuple):
+    """The round cone's distance, its region masks and what its gradient reuses."""
+
+    d: FloatArray
+    q: FloatArray
+    x: FloatArray
+    sn: FloatArray  # side normal's axial part
+    c: FloatArray  # side normal's radial part
+    pb: FloatArray  # p − b
+    pa_len: FloatArray
+    pb_len: FloatArray
+    cap_a: BoolArray
+    cap_b: BoolArray
+
+
+def _tapered_distance(fr: _Frame) -> _TaperedCore:
+    t = np.clip(fr.t_raw, 0.0, 1.0)
+    q = fr.pa - fr.ba * t[..., None]
+    x = _norm(q)
+    return _TaperedCore(x - (fr.ra + (fr.rb - fr.ra) * t), q, x)
+
+
+def _round_cone_distance(fr: _Frame) -> _ConeCore:
     dr = fr.ra - fr.rb
     nested = (np.abs(dr) >= fr.length) | fr.degenerate
     with np.errstate(divide="ignore", invalid="ignore"):
@@ -143,17 +197,11 @@ def round_cone_field(
     # Nested: the larger end sphere, taking a on a tie of radii.
     cap_a = cap_a | (nested & (fr.ra >= fr.rb))
     cap_b = cap_b | (nested & (fr.ra < fr.rb))
-
     pb = fr.pa - fr.ba
     pa_len, pb_len = _norm(fr.pa), _norm(pb)
     side_d = sn * (fr.t_raw * fr.length) + c * x - fr.ra
     d = np.where(cap_a, pa_len - fr.ra, np.where(cap_b, pb_len - fr.rb, side_d))
-
-    g_a = _unit(fr.pa, pa_len, fr.floor, -fr.axis)
-    g_b = _unit(pb, pb_len, fr.floor, fr.axis)
-    g_side = c[..., None] * _unit(q, x, fr.floor, fr.perpendicular) + sn[..., None] * fr.axis
-    g = np.where(cap_a[..., None], g_a, np.where(cap_b[..., None], g_b, g_side))
-    return d, g
+    return _ConeCore(d, q, x, sn, c, pb, pa_len, pb_len, cap_a, cap_b)
 
 
 class _Frame:
@@ -182,15 +230,33 @@ class _Frame:
         scale = self.length + np.maximum(self.ra, self.rb)
         self.floor = np.maximum(floor * scale, np.finfo(dtype).tiny)
         self.degenerate = self.length <= self.floor
-        safe_length = np.where(self.degenerate, 1.0, self.length)
-        z_axis = np.zeros_like(self.ba)
-        z_axis[..., 2] = 1.0
-        self.axis = np.where(self.degenerate[..., None], z_axis, self.ba / safe_length[..., None])
-        self.slope = np.where(self.degenerate, 0.0, (self.rb - self.ra) / safe_length)
         self.pa = pts - a
         length_sq = np.where(self.degenerate, 1.0, _dot(self.ba, self.ba))
         self.t_raw = np.where(self.degenerate, 0.0, _dot(self.pa, self.ba) / length_sq)
-        self.perpendicular = _perpendicular(self.axis)
+
+    # Only the gradient needs these; the distance-only path never computes them.
+    @cached_property
+    def _safe_length(self) -> FloatArray:
+        result: FloatArray = np.where(self.degenerate, 1.0, self.length)
+        return result
+
+    @cached_property
+    def axis(self) -> FloatArray:
+        z_axis = np.zeros_like(self.ba)
+        z_axis[..., 2] = 1.0
+        result: FloatArray = np.where(
+            self.degenerate[..., None], z_axis, self.ba / self._safe_length[..., None]
+        )
+        return result
+
+    @cached_property
+    def slope(self) -> FloatArray:
+        result: FloatArray = np.where(self.degenerate, 0.0, (self.rb - self.ra) / self._safe_length)
+        return result
+
+    @cached_property
+    def perpendicular(self) -> FloatArray:
+        return _perpendicular(self.axis)
 
 
 def _perpendicular(axis: FloatArray) -> FloatArray:

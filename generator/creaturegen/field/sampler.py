@@ -15,10 +15,10 @@ import numpy.typing as npt
 from ..rig import CompiledRig
 from ..rig.graph import BlendGraph, Ref
 from . import layout as col
-from .blend import hard_min, lse_smin, poly_smin
+from .blend import hard_min, lse_smin, lse_smin_distance, poly_smin, poly_smin_distance
 from .colour import proximity_colour
 from .floors import floors_for
-from .primitives import primitive_field
+from .primitives import primitive_distance, primitive_field
 
 Array = npt.NDArray[np.floating]
 
@@ -74,6 +74,32 @@ def evaluate_graph(graph: BlendGraph, d_slots: Array, g_slots: Array) -> tuple[A
     return d, g
 
 
+def evaluate_distance(graph: BlendGraph, d_slots: Array) -> Array:
+    """The body's distance alone, bit-identical to ``evaluate_graph``'s; no gradient is formed."""
+    values: list[Array] = []
+    for op in graph.ops:
+        ds = [d_slots[c.index] if c.kind == "slot" else values[c.index] for c in op.children]
+        if op.kernel == "poly":
+            d, _ = poly_smin_distance(ds[0], ds[1], op.k)
+        else:
+            d, _ = lse_smin_distance(np.stack(ds), op.k)
+        values.append(d)
+    roots = np.stack([d_slots[r.index] if r.kind == "slot" else values[r.index] for r in graph.roots])
+    result: Array = roots[np.argmin(roots, axis=0), np.arange(roots.shape[1])]
+    return result
+
+
+def sample_distance(
+    graph: BlendGraph,
+    slots: npt.NDArray[np.float64],
+    points: npt.ArrayLike,
+    dtype: type[np.floating] = np.float64,
+) -> Array:
+    """Distance only, for central-difference taps: the sampler's formulas without the gradient work."""
+    p = np.asarray(points, dtype=dtype).reshape(-1, 3)
+    return evaluate_distance(graph, primitive_distance(slots, p, dtype=dtype))
+
+
 def sample_graph(
     graph: BlendGraph,
     slots: npt.NDArray[np.float64],
@@ -83,8 +109,9 @@ def sample_graph(
 ) -> FieldSample:
     """Evaluate any program over the slot rows it indexes (a full rig, or a candidate's kept leaves)."""
     p = np.asarray(points, dtype=dtype).reshape(-1, 3)
+    # The float64 table goes to primitive_field so each slot's form is chosen on exact values.
+    d_slots, g_slots = primitive_field(slots, p, dtype=dtype)
     table = slots.astype(dtype)
-    d_slots, g_slots = primitive_field(table, p, dtype=dtype)
     distance, gradient = evaluate_graph(graph, d_slots, g_slots)
     color = proximity_colour(d_slots, table[:, col.K], table[:, col.RGB], k_floor)
     return FieldSample(distance, gradient, color)

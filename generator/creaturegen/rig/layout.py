@@ -25,7 +25,6 @@ from ..spec.character import Part
 LEG_DROP_MIN = 0.5
 LEG_DROP_MAX = 0.95
 ROPE_DIRECTION = (0.0, 0.0, -1.0)
-KNEE_DIRECTION = (0.0, 0.0, 1.0)
 
 Vec = tuple[float, float, float]
 
@@ -89,7 +88,7 @@ def _leg(part: Part, origin: Vec) -> PartSlots:
     foot = (hip[0], hip[1] - drop, hip[2])
     cos_hip = (upper * upper + drop * drop - lower * lower) / (2.0 * upper * drop)
     angle = math.acos(max(-1.0, min(1.0, cos_hip)))
-    knee = (hip[0], hip[1] - upper * math.cos(angle), hip[2] + upper * math.sin(angle) * KNEE_DIRECTION[2])
+    knee = (hip[0], hip[1] - upper * math.cos(angle), hip[2] + upper * math.sin(angle))  # bends toward +Z
     rows = [_row(hip, r, knee, r), _row(knee, r, foot, r)]
     return PartSlots(np.array(rows, dtype=np.float64), ("leg-upper", "leg-lower"))
 
