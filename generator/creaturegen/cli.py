@@ -16,10 +16,12 @@ import numpy as np
 
 from . import __version__
 from .candidates import TIERS, describe_candidates
+from .emit import PackageWriteError
 from .field.sampler import sample
+from .frost.build import build_frost
 from .rig import CompiledRig, RigCompileError, compile_rig
 from .rig.report import describe_rig
-from .spec import CharacterSpec, SpecError, SpecValidationError, load_spec
+from .spec import CharacterSpec, FrostEffectSpec, SpecError, SpecValidationError, load_spec, validate_bytes
 from .spec.schema import stale_schemas, write_schemas
 from .spec.summary import summarize
 
@@ -73,14 +75,42 @@ def _schema(args: argparse.Namespace) -> int:
 
 
 def _build(args: argparse.Namespace) -> int:
+    source = Path(args.spec)
     try:
-        spec = load_spec(Path(args.spec))
+        data = source.read_bytes()
+    except OSError as exc:
+        print_errors(args.spec, [SpecError("spec", f"cannot be read: {exc.strerror}")])
+        return EXIT_INVALID
+    try:
+        spec = validate_bytes(data, args.spec)
     except SpecValidationError as exc:
         print_errors(args.spec, exc.errors)
         return EXIT_INVALID
     print(f"{args.spec}: ok")
     print("\n".join(summarize(spec)))
-    print(f"note: the package emitter is not implemented yet; nothing was written to {args.out}/")
+    if not isinstance(spec, FrostEffectSpec):
+        print(
+            f"note: the creature package emitter is not implemented yet; nothing was written to {args.out}/"
+        )
+        return EXIT_OK
+    print(
+        "==> frost: quantisation gate (30/60/120 FPS replays per storage format), structure maps", flush=True
+    )
+    try:
+        folder = build_frost(spec, data, Path(args.out))
+    except ValueError as exc:
+        print_errors(args.spec, [SpecError("tier.historyFormat", str(exc))])
+        return EXIT_INVALID
+    except PackageWriteError as exc:
+        print(f"{args.spec}: cannot write the package: {exc}", file=sys.stderr)
+        return EXIT_INVALID
+    report = json.loads((folder / "build-report.json").read_text())
+    for gate in report["gates"]:
+        print(
+            f"  gate {gate['name']}: {gate['value']:.3g} (threshold {gate['threshold']:.3g}) {gate['status']}"
+        )
+    print(f"  history format {report['historyFormat']['historyFormat']}")
+    print(f"wrote {folder}/")
     return EXIT_OK
 
 

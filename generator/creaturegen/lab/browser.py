@@ -22,12 +22,14 @@ from playwright.sync_api import TimeoutError as PlaywrightTimeoutError
 #: Exactly the DESIGN.md set ("Real components"), verified on Debian 12 with Debian's chromium 156.
 #: Without --enable-unsafe-webgpu there is no adapter and three silently falls back to WebGL2; the
 #: swiftshader switches pin the software adapter so results do not depend on the host GPU.
-#: --use-angle=swiftshader was measured and changed nothing here (WebGL already ran on ANGLE over
-#: SwiftShader Vulkan), so it is left out.
+#: --use-angle=swiftshader is needed as soon as a page presents WebGPU to a canvas: without it the first
+#: canvas frame loses the device ("A valid external Instance reference no longer exists"), measured with
+#: the frost lab; compute-only and render-target pages work either way.
 CHROMIUM_FLAGS: tuple[str, ...] = (
     "--no-sandbox",
     "--enable-unsafe-webgpu",
     "--enable-features=Vulkan",
+    "--use-angle=swiftshader",
     "--use-vulkan=swiftshader",
     "--use-webgpu-adapter=swiftshader",
     "--disable-vulkan-surface",

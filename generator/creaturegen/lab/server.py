@@ -44,7 +44,25 @@ DEFAULT_PORT = 8765
 
 
 class LabRequestHandler(http.server.SimpleHTTPRequestHandler):
-    """Static files with pinned MIME types, no caching and no per-request log lines."""
+    """Static files with pinned MIME types, no caching and no per-request log lines.
+
+    ``mounts`` maps a first URL segment to another folder: the lab serves built packages from
+    ``/out/<slug>/`` while its own files and node_modules stay in web_lab/.
+    """
+
+    def __init__(self, *args: Any, mounts: dict[str, Path] | None = None, **kwargs: Any) -> None:
+        self.mounts = mounts or {}
+        super().__init__(*args, **kwargs)
+
+    def translate_path(self, path: str) -> str:
+        clean = posixpath.normpath(path.split("?", 1)[0].split("#", 1)[0])
+        parts = [p for p in clean.split("/") if p]
+        if parts and parts[0] in self.mounts:
+            root = self.mounts[parts[0]].resolve()
+            target = root.joinpath(*parts[1:]).resolve()
+            # normpath already removed "..", but a symlink could still point outside: refuse that too.
+            return str(target) if target.is_relative_to(root) else str(root / "__outside__")
+        return super().translate_path(path)
 
     def guess_type(self, path: str | os.PathLike[str]) -> str:
         ext = posixpath.splitext(os.fspath(path))[1].lower()
@@ -71,19 +89,23 @@ class _QuietThreadingServer(http.server.ThreadingHTTPServer):
         super().handle_error(request, client_address)
 
 
-def make_server(root: Path, host: str = DEFAULT_HOST, port: int = 0) -> http.server.ThreadingHTTPServer:
+def make_server(
+    root: Path, host: str = DEFAULT_HOST, port: int = 0, mounts: dict[str, Path] | None = None
+) -> http.server.ThreadingHTTPServer:
     """Bind (port 0 picks a free one) without serving yet, so callers learn the real port first."""
     root = Path(root).resolve()
     if not root.is_dir():
         raise FileNotFoundError(f"lab server root {root} is not a directory")
-    handler = functools.partial(LabRequestHandler, directory=str(root))
+    handler = functools.partial(LabRequestHandler, directory=str(root), mounts=dict(mounts or {}))
     return _QuietThreadingServer((host, port), handler)
 
 
 @contextlib.contextmanager
-def serve(root: Path, port: int = 0, host: str = DEFAULT_HOST) -> Iterator[str]:
+def serve(
+    root: Path, port: int = 0, host: str = DEFAULT_HOST, mounts: dict[str, Path] | None = None
+) -> Iterator[str]:
     """Serve ``root`` on a background thread for the duration of a with-block; yields the base URL."""
-    server = make_server(root, host, port)
+    server = make_server(root, host, port, mounts)
     thread = threading.Thread(target=server.serve_forever, name="creaturegen-lab-http", daemon=True)
     thread.start()
     try:
@@ -104,10 +126,16 @@ def main(argv: Sequence[str] | None = None) -> int:
     )
     parser.add_argument("--host", default=DEFAULT_HOST, help=f"bind address (default: {DEFAULT_HOST})")
     parser.add_argument("--port", type=int, default=DEFAULT_PORT, help=f"port (default: {DEFAULT_PORT})")
+    parser.add_argument("--out", type=Path, default=Path("out"), help="built packages, served at /out/")
     args = parser.parse_args(argv)
-    server = make_server(args.root, args.host, args.port)
-    print(f"==> serving {Path(args.root).resolve()} at http://{args.host}:{server.server_address[1]}/")
-    print("    open /smoke.html for the WebGPU smoke page; Ctrl-C stops the server", flush=True)
+    server = make_server(args.root, args.host, args.port, {"out": args.out})
+    base = f"http://{args.host}:{server.server_address[1]}/"
+    print(
+        f"==> serving {Path(args.root).resolve()} at {base}, packages from {Path(args.out).resolve()} at /out/"
+    )
+    print(f"    {base}smoke.html  WebGPU smoke page")
+    print(f"    {base}frost.html?pkg=<slug>  a built frost package, e.g. after `make build EXAMPLE=...`")
+    print("    Ctrl-C stops the server", flush=True)
     try:
         server.serve_forever()
     except KeyboardInterrupt:

@@ -19,8 +19,8 @@ TierName = Literal["full", "balanced", "budgeted"]
 #: Largest history resolution scale each tier admits (full-res, half-res, quarter-res in the seed).
 TIER_MAX_HISTORY_SCALE: dict[str, float] = {"full": 1.0, "balanced": 0.5, "budgeted": 0.25}
 
-#: Storage formats proven storage-writable on the target adapters; compact formats need that proof first.
-HistoryFormat = Literal["rgba16float", "rgba32float"]
+#: Storage formats proven storage-writable on the target adapters; "auto" lets the quantisation gate choose.
+HistoryFormat = Literal["auto", "rgba16float", "rgba32float"]
 
 
 class HistoryChannel(StrictModel):
@@ -93,7 +93,10 @@ class Tier(StrictModel):
         default=None,
         description="History resolution / drawing-buffer resolution; default: the tier's largest.",
     )
-    historyFormat: HistoryFormat = "rgba16float"
+    historyFormat: HistoryFormat = Field(
+        default="auto",
+        description="History storage; auto picks the most compact format that passes the quantisation gate.",
+    )
     blurScale: Annotated[Number, Field(gt=0, le=1)] = Field(
         default=0.5, description="Blur pass resolution / drawing-buffer resolution."
     )

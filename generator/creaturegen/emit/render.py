@@ -1,0 +1,54 @@
+"""Render a template folder with a plan: ``*.j2`` files through Jinja, everything else verbatim.
+
+Templates only print the plan (values and loops); anything computed belongs in the plan builder. User text
+reaches code only as JSON: the ``tojson_sorted`` filter is the one way a plan value enters a JS file.
+"""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+from typing import Any
+
+import jinja2
+
+from .writer import PackageFile, header_for
+
+TEMPLATES = Path(__file__).resolve().parents[3] / "templates"
+
+
+def to_json(value: Any, indent: int | None = 2) -> str:
+    """Deterministic JSON: sorted keys, shortest round-trip floats (repr), no NaN, ASCII only."""
+    return json.dumps(value, indent=indent, sort_keys=True, ensure_ascii=True, allow_nan=False)
+
+
+def environment(folder: Path) -> jinja2.Environment:
+    env = jinja2.Environment(
+        loader=jinja2.FileSystemLoader(str(folder)),
+        undefined=jinja2.StrictUndefined,
+        autoescape=False,
+        keep_trailing_newline=True,
+        trim_blocks=True,
+        lstrip_blocks=True,
+    )
+    env.filters["tojson_sorted"] = to_json
+    return env
+
+
+def render_folder(kind: str, plan: dict[str, Any], spec_sha256: str) -> list[PackageFile]:
+    """Every file of ``templates/<kind>/`` rendered with ``plan``, each with its generated-code header."""
+    folder = TEMPLATES / kind
+    env = environment(folder)
+    files = []
+    for source in sorted(p for p in folder.rglob("*") if p.is_file()):
+        relative = source.relative_to(folder).as_posix()
+        if relative.endswith(".j2"):
+            relative = relative[: -len(".j2")]
+            text = env.get_template(source.relative_to(folder).as_posix()).render(plan=plan)
+        else:
+            text = source.read_text(encoding="utf-8")
+        header = header_for(relative, spec_sha256)
+        if header is not None:
+            text = f"{header}\n{text}"
+        files.append(PackageFile(relative, text.encode("utf-8")))
+    return files

@@ -1,0 +1,1 @@
+"""Frost/thaw surface effect: law, brush, reference simulation, static structure."""

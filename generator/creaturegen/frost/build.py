@@ -1,0 +1,37 @@
+"""Build a frost package: plan → templates + assets + build-report.json → out/<slug>/ (atomically)."""
+
+from __future__ import annotations
+
+import hashlib
+from pathlib import Path
+
+from ..emit.render import render_folder, to_json
+from ..emit.writer import PackageFile, header_text, write_package
+from ..spec.frost import FrostEffectSpec
+from .plan import build_plan
+
+
+def build_report(plan: dict[str, object]) -> dict[str, object]:
+    return {
+        "//": header_text(str(plan["specSha256"])),
+        "kind": "frost",
+        "name": plan["name"],
+        "package": plan["slug"],
+        "compilerVersion": plan["version"],
+        "specSha256": plan["specSha256"],
+        "historyFormat": plan["tier"],
+        "structureSha256": plan["structure"]["sha256"],  # type: ignore[index]
+        "memory": plan["memory"],
+        "gates": plan["gates"],
+    }
+
+
+def build_frost(spec: FrostEffectSpec, spec_bytes: bytes, out_root: Path) -> Path:
+    """Write the package and return its folder. Nothing is written if any step raises."""
+    spec_sha256 = hashlib.sha256(spec_bytes).hexdigest()
+    built = build_plan(spec, spec_sha256)
+    files = render_folder("frost", built.plan, spec_sha256)
+    files.append(PackageFile("assets/structure.bin", built.structure.structure.tobytes()))
+    files.append(PackageFile("assets/normals.bin", built.structure.normals.tobytes()))
+    files.append(PackageFile("build-report.json", (to_json(build_report(built.plan)) + "\n").encode()))
+    return write_package(out_root, str(built.plan["slug"]), files)

@@ -1,0 +1,190 @@
+"""The numpy reference simulation of the frost history: same grid, same law, same brush, same diffusion.
+
+It mirrors the GPU pipeline dispatch for dispatch (retire clears, then update chunks of at most
+``max_steps`` input intervals, then diffusion substeps), so that with ``storage="float16"`` it also rounds
+where the GPU writes its RGBA16F textures. With ``storage="float64"`` nothing is rounded: that is the form
+in which 30, 60 and 120 FPS replays of one pointer path must agree to 1e-12, since the closed-form law
+composes exactly for piecewise-constant input.
+
+State layout (H, W, 4), like the textures: R visible thaw, G visible deposit of the last frame (debug),
+B tilt deposit of the last frame (debug), A tilt response.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Literal
+
+import numpy as np
+
+from .brush import Segment, coverage, texel_noise
+from .law import Array, advance
+from .params import FrostParams
+from .schedule import BoolGrid, TilePlan, TileScheduler, diffusion_substeps
+from .timeline import Decision, Step, chunk_steps, classify_interval, split_interval, validate_segment
+
+Storage = Literal["float16", "float32", "float64"]
+
+#: numpy dtype that rounds like each history texture format when the GPU stores a texel.
+STORAGE_OF_FORMAT: dict[str, Storage] = {"rgba16float": "float16", "rgba32float": "float32"}
+STATE_CHANNELS = (0, 3)  # R, A hold state; G, B are the last frame's deposits.
+DEPOSIT_CHANNELS = (1, 2)
+
+
+@dataclass
+class FrameReport:
+    """What one update did: the same counters the lab publishes per frame."""
+
+    decision: Decision
+    steps: int = 0
+    dispatches: int = 0
+    texels: int = 0
+    update_tiles: int = 0
+    retired_tiles: int = 0
+    substeps: int = 0
+
+
+@dataclass
+class Counters:
+    frames: int = 0
+    discontinuities: int = 0
+    dispatches: int = 0
+    texels: int = 0
+    history: list[FrameReport] = field(default_factory=list)
+
+
+class FrostReference:
+    """A stateful history on the CPU; feed it the lab's segments and instants, read ``state``."""
+
+    def __init__(self, params: FrostParams, width: int, height: int, storage: Storage = "float64") -> None:
+        self.params = params
+        self.storage = storage
+        self.counters = Counters()
+        self.pending: list[Segment] = []
+        self._last_end: float | None = None
+        self._allocate(width, height)
+
+    def _allocate(self, width: int, height: int) -> None:
+        self.width, self.height = width, height
+        self.state = np.zeros((height, width, 4))
+        self.scheduler = TileScheduler(self.params, width, height)
+        self.thinning = [
+            channel.noise * texel_noise(width, height, self.params.seed, index)
+            for index, channel in enumerate(self.params.channels)
+        ]
+
+    def _store(self, values: Array) -> Array:
+        if self.storage == "float64":
+            return values
+        return np.asarray(values.astype(self.storage).astype(np.float64))
+
+    def queue(self, segment: Segment) -> None:
+        problem = validate_segment(segment, self._last_end)
+        if problem is not None:
+            raise ValueError(problem)
+        self.pending.append(segment)
+        self._last_end = segment.t1
+
+    def update(self, previous: float, current: float) -> FrameReport:
+        decision = classify_interval(previous, current, self.params.max_interval)
+        report = FrameReport(decision=decision)
+        if decision == "none":
+            return report
+        self.counters.frames += 1
+        if decision == "discontinuity":
+            self.counters.discontinuities += 1
+            self.pending = []
+            self._last_end = None
+            if self.params.discontinuity == "reset":
+                self._allocate(self.width, self.height)
+            self.counters.history.append(report)
+            return report
+        steps = split_interval(previous, current, self.pending)
+        substeps = diffusion_substeps(self.params.diffusivity, current - previous, self.height)
+        plan = self.scheduler.plan(steps, current - previous, substeps)
+        self._apply(plan, steps, substeps, report, current - previous)
+        self.pending = [g for g in self.pending if g.t1 > current]
+        self.counters.dispatches += report.dispatches
+        self.counters.texels += report.texels
+        self.counters.history.append(report)
+        return report
+
+    def _apply(
+        self, plan: TilePlan, steps: list[Step], substeps: int, report: FrameReport, frame_dt: float
+    ) -> None:
+        w, h = self.width, self.height
+        report.steps, report.update_tiles, report.retired_tiles = (
+            len(steps),
+            len(plan.update),
+            len(plan.retire),
+        )
+        if plan.retire:
+            self.state[plan.mask(plan.retire, w, h)] = 0.0
+            report.dispatches += 1
+            report.texels += plan.texels(plan.retire, w, h)
+        if not plan.update:
+            return
+        mask = plan.mask(plan.update, w, h)
+        texels = plan.texels(plan.update, w, h)
+        for chunk_index, chunk in enumerate(chunk_steps(steps, self.params.max_steps)):
+            self._law(chunk, mask, first=chunk_index == 0)
+            report.dispatches += 1
+            report.texels += texels
+        report.substeps = substeps
+        if substeps:
+            rate = self.params.diffusivity * (frame_dt / substeps) * h * h
+            for _ in range(substeps):
+                self._diffuse(rate, mask)
+                report.dispatches += 1
+                report.texels += texels
+
+    def _law(self, steps: list[Step], mask: BoolGrid, first: bool) -> None:
+        x = [self.state[..., c].copy() for c in STATE_CHANNELS]
+        deposit = [np.zeros_like(x[0]) if first else self.state[..., c].copy() for c in DEPOSIT_CHANNELS]
+        for step in steps:
+            for index, channel in enumerate(self.params.channels):
+                if step.segment is None:
+                    b: Array | float = 0.0
+                else:
+                    b = coverage(
+                        step.segment,
+                        self.width,
+                        self.height,
+                        channel.radius,
+                        self.params.softness,
+                        self.thinning[index],
+                    )
+                    deposit[index] = np.maximum(deposit[index], b)
+                x[index] = advance(x[index], b, step.dt, channel.decay, channel.fill)
+        for c, value in zip((*STATE_CHANNELS, *DEPOSIT_CHANNELS), (*x, *deposit), strict=True):
+            self.state[..., c] = np.where(mask, self._store(value), self.state[..., c])
+
+    def _diffuse(self, rate: float, mask: BoolGrid) -> None:
+        for c in STATE_CHANNELS:
+            x = self.state[..., c]
+            padded = np.pad(x, 1, mode="edge")
+            laplacian = padded[:-2, 1:-1] + padded[2:, 1:-1] + padded[1:-1, :-2] + padded[1:-1, 2:] - 4.0 * x
+            self.state[..., c] = np.where(mask, self._store(x + rate * laplacian), x)
+
+    def resize(self, width: int, height: int) -> None:
+        """Apply the declared resize policy: clear, or remap the old history bilinearly by UV."""
+        if self.params.resize_policy == "clear" or self.counters.frames == 0:
+            self._allocate(width, height)
+            return
+        old, bounds = self.state, self.scheduler.bounds.max(axis=(1, 2))
+        self._allocate(width, height)
+        self.state = self._store(remap_bilinear(old, width, height))
+        self.scheduler.mark_all((float(bounds[0]), float(bounds[1])))
+
+
+def remap_bilinear(state: Array, width: int, height: int) -> Array:
+    """Resample (H, W, C) at the new texel centres by UV; clamp-to-edge, like the GPU kernel's loads."""
+    old_h, old_w = state.shape[:2]
+    x = np.clip((np.arange(width) + 0.5) / width * old_w - 0.5, 0.0, old_w - 1.0)
+    y = np.clip((np.arange(height) + 0.5) / height * old_h - 0.5, 0.0, old_h - 1.0)
+    x0, y0 = np.floor(x).astype(int), np.floor(y).astype(int)
+    x1, y1 = np.minimum(x0 + 1, old_w - 1), np.minimum(y0 + 1, old_h - 1)
+    fx, fy = (x - x0)[None, :, None], (y - y0)[:, None, None]
+    top = state[y0][:, x0] * (1 - fx) + state[y0][:, x1] * fx
+    bottom = state[y1][:, x0] * (1 - fx) + state[y1][:, x1] * fx
+    return np.asarray(top * (1 - fy) + bottom * fy)

@@ -1,0 +1,190 @@
+// Pure JS, zero three imports: the frost effect's time policy, input intervals and tile scheduler.
+// Line for line the same algorithm as generator/creaturegen/frost/{timeline,schedule}.py; the numbers
+// (rates, radii, tolerance, policy) come from plan.js, which the compiler wrote from the same FrostParams.
+
+/** 'advance' | 'none' (equal instants) | 'discontinuity' (reversed, non-finite or too long). */
+export function classifyInterval(previous, current, maxInterval) {
+  if (!Number.isFinite(previous) || !Number.isFinite(current)) return 'discontinuity';
+  if (current === previous) return 'none';
+  if (current < previous || current - previous > maxInterval) return 'discontinuity';
+  return 'advance';
+}
+
+/** Why a segment is refused, or null: one pointer stream, time-ordered, non-overlapping, finite. */
+export function validateSegment(segment, lastEnd) {
+  const values = [segment.t0, segment.t1, ...segment.start, ...segment.end, segment.pressure0, segment.pressure1];
+  if (segment.start.length !== 2 || segment.end.length !== 2) return 'start and end must be [u, v]';
+  if (!values.every((v) => typeof v === 'number' && Number.isFinite(v))) return 'segment values must be finite';
+  if (segment.t1 < segment.t0) return `segment ends (${segment.t1}) before it starts (${segment.t0})`;
+  if (lastEnd !== null && segment.t0 < lastEnd) {
+    return `segment starts at ${segment.t0}, before the previous one ended (${lastEnd})`;
+  }
+  if (!(segment.pressure0 >= 0 && segment.pressure0 <= 1 && segment.pressure1 >= 0 && segment.pressure1 <= 1)) {
+    return 'pressures must lie in [0, 1]';
+  }
+  return null;
+}
+
+/** A segment with defaults filled in: pressures 1. */
+export function normalizeSegment({ t0, t1, start, end, pressure0 = 1, pressure1 = 1 }) {
+  return { t0, t1, start: [start[0], start[1]], end: [end[0], end[1]], pressure0, pressure1 };
+}
+
+/** Pointer NDC in [-1, 1], y up, to history UV (origin top-left, v down). */
+export function pointerUV(ndcX, ndcY) {
+  return [0.5 * (ndcX + 1), 0.5 * (1 - ndcY)];
+}
+
+/** floor(x + 0.5), the rounding the Python side uses too (round() there rounds halves to even). */
+export function scaledSize(width, height, scale) {
+  return [Math.max(1, Math.floor(width * scale + 0.5)), Math.max(1, Math.floor(height * scale + 0.5))];
+}
+
+/** Cut [previous, current) at every segment boundary inside it: piecewise-constant input intervals. */
+export function splitInterval(previous, current, segments) {
+  const cuts = [previous, current];
+  for (const g of segments) {
+    for (const t of [g.t0, g.t1]) if (previous < t && t < current) cuts.push(t);
+  }
+  cuts.sort((a, b) => a - b);
+  const ordered = cuts.filter((t, i) => i === 0 || t !== cuts[i - 1]);
+  const steps = [];
+  for (let i = 0; i + 1 < ordered.length; i++) {
+    const s0 = ordered[i];
+    const s1 = ordered[i + 1];
+    const active = segments.find((g) => g.t0 <= s0 && s1 <= g.t1 && g.t1 > g.t0) ?? null;
+    steps.push({ dt: s1 - s0, segment: active });
+  }
+  return steps;
+}
+
+export function chunkSteps(steps, maxSteps) {
+  const chunks = [];
+  for (let i = 0; i < steps.length; i += maxSteps) chunks.push(steps.slice(i, i + maxSteps));
+  return chunks;
+}
+
+/** Substeps keeping D·(dt/n)/dx² ≤ 1/4 with dx = 1/H; 0 without diffusion. */
+export function diffusionSubsteps(diffusivity, dt, height, stability) {
+  const number = diffusivity * dt * height * height;
+  return number > 0 ? Math.ceil(number / stability) : 0;
+}
+
+/**
+ * Per-tile analytic channel bounds decide what a frame dispatches: touched tiles get bound 1, diffusion
+ * dilates bounds by its halo, the rest decay by exp(-λ·dt); a tile at or below the tolerance retires
+ * (both ping-pong textures cleared to 0, the law's fixed point without input). Full-field is one tile.
+ */
+export class TileScheduler {
+  constructor(params, width, height) {
+    this.params = params;
+    const full = params.policy === 'full-field';
+    this.tileWidth = full ? width : params.tileSize;
+    this.tileHeight = full ? height : params.tileSize;
+    this.tilesX = Math.ceil(width / this.tileWidth);
+    this.tilesY = Math.ceil(height / this.tileHeight);
+    this.width = width;
+    this.height = height;
+    this.count = this.tilesX * this.tilesY;
+    this.bounds = [new Float64Array(this.count), new Float64Array(this.count)];
+    this.live = new Uint8Array(this.count);
+    this.update = new Uint32Array(this.count);
+    this.retire = new Uint32Array(this.count);
+    this.scratch = new Float64Array(this.count);
+    this.touchedMask = new Uint8Array(this.count);
+  }
+
+  touched(steps) {
+    const touched = this.touchedMask;
+    touched.fill(0);
+    const reach = Math.max(this.params.visible.radius, this.params.tilt.radius);
+    for (const step of steps) {
+      const g = step.segment;
+      if (g === null || 0.5 * (g.pressure0 + g.pressure1) <= 0 || step.dt <= 0) continue;
+      const rx = (reach * this.height) / this.width;
+      let x0 = Math.floor((Math.min(g.start[0], g.end[0]) - rx) * this.width);
+      let x1 = Math.floor((Math.max(g.start[0], g.end[0]) + rx) * this.width);
+      let y0 = Math.floor((Math.min(g.start[1], g.end[1]) - reach) * this.height);
+      let y1 = Math.floor((Math.max(g.start[1], g.end[1]) + reach) * this.height);
+      x0 = Math.max(x0, 0);
+      x1 = Math.min(x1, this.width - 1);
+      y0 = Math.max(y0, 0);
+      y1 = Math.min(y1, this.height - 1);
+      if (x0 > x1 || y0 > y1) continue;
+      for (let ty = Math.floor(y0 / this.tileHeight); ty <= Math.floor(y1 / this.tileHeight); ty++) {
+        for (let tx = Math.floor(x0 / this.tileWidth); tx <= Math.floor(x1 / this.tileWidth); tx++) {
+          touched[ty * this.tilesX + tx] = 1;
+        }
+      }
+    }
+    return touched;
+  }
+
+  dilate(halo) {
+    for (const bound of this.bounds) {
+      const out = this.scratch;
+      for (let ty = 0; ty < this.tilesY; ty++) {
+        for (let tx = 0; tx < this.tilesX; tx++) {
+          let m = 0;
+          for (let dy = -halo; dy <= halo; dy++) {
+            const y = Math.min(Math.max(ty + dy, 0), this.tilesY - 1);
+            for (let dx = -halo; dx <= halo; dx++) {
+              const x = Math.min(Math.max(tx + dx, 0), this.tilesX - 1);
+              m = Math.max(m, bound[y * this.tilesX + x]);
+            }
+          }
+          out[ty * this.tilesX + tx] = m;
+        }
+      }
+      bound.set(out);
+    }
+  }
+
+  /** Returns { updateCount, retireCount } and fills this.update / this.retire (row-major tile ids). */
+  plan(steps, frameDt, substeps) {
+    if (substeps > 0) this.dilate(Math.ceil(substeps / Math.min(this.tileWidth, this.tileHeight)));
+    const decays = [this.params.visible.decay, this.params.tilt.decay];
+    for (let c = 0; c < 2; c++) {
+      const factor = Math.exp(-decays[c] * frameDt);
+      const bound = this.bounds[c];
+      for (let t = 0; t < this.count; t++) bound[t] *= factor;
+    }
+    const touched = this.touched(steps);
+    const always = this.params.policy === 'full-field' && !this.params.idleWhenConverged;
+    let updateCount = 0;
+    let retireCount = 0;
+    for (let t = 0; t < this.count; t++) {
+      if (touched[t]) {
+        this.bounds[0][t] = 1;
+        this.bounds[1][t] = 1;
+      }
+      const live = always || this.bounds[0][t] > this.params.tolerance || this.bounds[1][t] > this.params.tolerance;
+      if (live) this.update[updateCount++] = t;
+      else {
+        if (this.live[t]) this.retire[retireCount++] = t;
+        this.bounds[0][t] = 0;
+        this.bounds[1][t] = 0;
+      }
+      this.live[t] = live ? 1 : 0;
+    }
+    return { updateCount, retireCount };
+  }
+
+  /** After a remapping resize every tile may hold content up to the old bounds. */
+  markAll(boundVisible, boundTilt) {
+    this.bounds[0].fill(boundVisible);
+    this.bounds[1].fill(boundTilt);
+    const live = boundVisible > this.params.tolerance || boundTilt > this.params.tolerance;
+    this.live.fill(live ? 1 : 0);
+  }
+
+  maxBounds() {
+    let v = 0;
+    let a = 0;
+    for (let t = 0; t < this.count; t++) {
+      v = Math.max(v, this.bounds[0][t]);
+      a = Math.max(a, this.bounds[1][t]);
+    }
+    return [v, a];
+  }
+}
