@@ -116,5 +116,5 @@ def frost_params(spec: FrostEffectSpec) -> FrostParams:
 
 
 def scaled_size(width: int, height: int, scale: float) -> tuple[int, int]:
-    """Reduced-resolution size, rounded with floor(x + 0.5): round() would round halves to even, JS does not."""
+    """Reduced-resolution size, rounded by floor(x + 0.5): round() rounds halves to even, JS does not."""
     return max(1, math.floor(width * scale + 0.5)), max(1, math.floor(height * scale + 0.5))

@@ -131,7 +131,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     server = make_server(args.root, args.host, args.port, {"out": args.out})
     base = f"http://{args.host}:{server.server_address[1]}/"
     print(
-        f"==> serving {Path(args.root).resolve()} at {base}, packages from {Path(args.out).resolve()} at /out/"
+        f"==> serving {Path(args.root).resolve()} at {base}; packages: {Path(args.out).resolve()} at /out/"
     )
     print(f"    {base}smoke.html  WebGPU smoke page")
     print(f"    {base}frost.html?pkg=<slug>  a built frost package, e.g. after `make build EXAMPLE=...`")
