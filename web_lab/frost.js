@@ -19,6 +19,7 @@ for (const name of ['createBuffer', 'createTexture', 'createBindGroup', 'createC
   const original = GPUDevice.prototype[name];
   GPUDevice.prototype[name] = function counted(...args) {
     deviceCounts[name] += 1;
+    if (name === 'createRenderPipeline') (window.__pipelineLabels ??= []).push(args[0]?.label ?? '?');
     return original.apply(this, args);
   };
 }
@@ -83,17 +84,21 @@ async function main() {
   console.log('lab: first render done');
   const revealCounts = { ...deviceCounts };
 
+  // One capture target, reused: a fresh RenderTarget per capture would build fresh pipelines.
+  let captureTarget = null;
   async function capturePixels(view = 'final') {
     const previous = effect.debugView ?? 'final';
     effect.setDebugView(view);
     const size = new THREE.Vector2();
     renderer.getDrawingBufferSize(size);
-    const target = new THREE.RenderTarget(size.x, size.y, { depthBuffer: false });
-    renderer.setRenderTarget(target);
+    if (!captureTarget || captureTarget.width !== size.x || captureTarget.height !== size.y) {
+      captureTarget?.dispose();
+      captureTarget = new THREE.RenderTarget(size.x, size.y, { depthBuffer: false });
+    }
+    renderer.setRenderTarget(captureTarget);
     render();
     renderer.setRenderTarget(null);
-    const padded = await renderer.readRenderTargetPixelsAsync(target, 0, 0, size.x, size.y);
-    target.dispose();
+    const padded = await renderer.readRenderTargetPixelsAsync(captureTarget, 0, 0, size.x, size.y);
     effect.setDebugView(previous);
     const rowBytes = Math.ceil((size.x * 4) / 256) * 256;
     const rgba = new Uint8Array(size.x * size.y * 4);
@@ -171,6 +176,23 @@ async function main() {
       }
       await device.queue.onSubmittedWorkDone();
       return performance.now() - start;
+    },
+    // bench helpers: the effect's blur node, found by wrapping its class's updateBefore for one render (lab
+    // code; the package is not modified). setBlurScale sets only that node's resolution scale, as setTier
+    // does (setTier puts the tier's scale back); the render here resizes the blur's two targets.
+    async setBlurScale(scale) {
+      const { SeparableBlurNode } = await import(`/out/${slug}/tsl/separable-blur.js`);
+      const proto = SeparableBlurNode.prototype;
+      const original = proto.updateBefore;
+      let node = null;
+      proto.updateBefore = function captured(frame) { node = this; return original.call(this, frame); };
+      try { render(); } finally { proto.updateBefore = original; }
+      if (node === null) throw new Error('frost lab: the blur node did not run during render()');
+      const previous = node.resolutionScale;
+      node.resolutionScale = scale;
+      render();
+      await device.queue.onSubmittedWorkDone();
+      return { previous, scale, size: [...node.size] };
     },
     play() { playing = true; lastInstant = null; requestAnimationFrame(loop); },
     pause() { playing = false; },

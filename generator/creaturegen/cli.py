@@ -1,6 +1,7 @@
 """The ``creaturegen`` command line: validate specs, export schemas, build packages.
 
-Exit codes: 0 success, 2 invalid input (bad spec, bad arguments). Nothing is written when a spec is invalid.
+Exit codes: 0 success, 1 a parity gate failed, 2 invalid input (bad spec, bad arguments). Nothing is
+written when a spec is invalid.
 """
 
 from __future__ import annotations
@@ -27,6 +28,7 @@ from .spec.summary import summarize
 
 EXIT_OK = 0
 EXIT_INVALID = 2
+EXIT_GATE_FAILED = 1
 
 _LINE_COLUMN = re.compile(r"^\d+:\d+$")
 
@@ -197,11 +199,40 @@ def _inspect(args: argparse.Namespace) -> int:
     return EXIT_OK
 
 
+def _parity(args: argparse.Namespace) -> int:
+    # Imported here: Playwright is only needed by this command, not by validate/build.
+    from .lab.frost_parity import run_frost_parity
+
+    canvas = tuple(int(v) for v in args.canvas.lower().split("x"))
+    failed = 0
+    for name in args.packages:
+        package = Path(name)
+        report_path = package / "build-report.json"
+        if not report_path.is_file():
+            print(
+                f"{name}: not a built package (no build-report.json); run `creaturegen build` first",
+                file=sys.stderr,
+            )
+            return EXIT_INVALID
+        kind = json.loads(report_path.read_text()).get("kind")
+        if kind != "frost":
+            print(f"{name}: parity for {kind!r} packages is not implemented yet", file=sys.stderr)
+            return EXIT_INVALID
+        print(f"==> parity {package.name}: headless Chromium, WebGPU on SwiftShader", flush=True)
+        report = run_frost_parity(package, (canvas[0], canvas[1]))
+        for gate in report.gates:
+            value, threshold = gate["value"], gate["threshold"]
+            print(f"  {gate['status']:4} {gate['name']}: {value:.4g} (threshold {threshold:.4g})")
+        print(f"  wrote {package / 'parity' / 'report.json'} and PNGs")
+        failed += not report.passed
+    return EXIT_GATE_FAILED if failed else EXIT_OK
+
+
 def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(
         prog="creaturegen",
         description="Compile JSON creature and frost specs into Three.js r185 WebGPU/TSL npm packages.",
-        epilog="Exit codes: 0 ok, 2 invalid spec or arguments. Errors name their place, e.g. part.body.r.",
+        epilog="Exit codes: 0 ok, 1 a parity gate failed, 2 invalid spec or arguments (errors name the place).",
     )
     parser.add_argument("--version", action="version", version=f"creaturegen {__version__}")
     commands = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
@@ -235,6 +266,15 @@ def build_parser() -> argparse.ArgumentParser:
     build.add_argument("spec", metavar="SPEC")
     build.add_argument("-o", "--out", default="out", help="output folder (default: out)")
     build.set_defaults(run=_build)
+
+    parity = commands.add_parser(
+        "parity", help="run built packages in the lab and diff against the reference"
+    )
+    parity.add_argument(
+        "packages", nargs="+", metavar="PKG", help="package folders, e.g. out/frost-pane-full"
+    )
+    parity.add_argument("--canvas", default="160x96", help="lab canvas size WxH (default: 160x96)")
+    parity.set_defaults(run=_parity)
     return parser
 
 

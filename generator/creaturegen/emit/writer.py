@@ -53,12 +53,22 @@ def _safe_target(root: Path, relative: str) -> Path:
     return target
 
 
+def _remove(path: Path) -> None:
+    """Delete a leftover backup, whether a folder or a plain file (or link)."""
+    if path.is_dir() and not path.is_symlink():
+        shutil.rmtree(path)
+    else:
+        path.unlink()
+
+
 def write_package(out_root: Path, slug: str, files: list[PackageFile]) -> Path:
     """Write ``files`` to ``out_root/slug`` atomically; returns the package folder."""
     if not slug or "/" in slug or slug in {".", ".."}:
         raise PackageWriteError(f"invalid package folder name {slug!r}")
     out_root.mkdir(parents=True, exist_ok=True)
     final = _safe_target(out_root, slug)
+    if final.exists() and not final.is_dir():
+        raise PackageWriteError(f"{final} exists and is not a folder; refusing to replace it")
     staging = Path(tempfile.mkdtemp(prefix=f".{slug}.", suffix=".tmp", dir=out_root))
     try:
         for item in sorted(files, key=lambda f: f.path):
@@ -71,12 +81,15 @@ def write_package(out_root: Path, slug: str, files: list[PackageFile]) -> Path:
         backup = None
         if final.exists():
             backup = final.with_name(f".{slug}.old")
-            if backup.exists():
-                shutil.rmtree(backup)
+            if backup.exists() or backup.is_symlink():
+                _remove(backup)
             final.rename(backup)
         staging.rename(final)
         if backup is not None:
-            shutil.rmtree(backup)
+            _remove(backup)
+    except OSError as exc:
+        shutil.rmtree(staging, ignore_errors=True)
+        raise PackageWriteError(f"cannot write {final}: {exc}") from exc
     except BaseException:
         shutil.rmtree(staging, ignore_errors=True)
         raise

@@ -22,6 +22,10 @@ def build_report(plan: dict[str, object]) -> dict[str, object]:
         "historyFormat": plan["tier"],
         "structureSha256": plan["structure"]["sha256"],  # type: ignore[index]
         "memory": plan["memory"],
+        "params": plan["params"],
+        "debugViews": plan["debugViews"],
+        "structure": plan["structure"],
+        "mainScreenPeriod": plan["refraction"]["mainScreenPeriod"],  # type: ignore[index]
         "gates": plan["gates"],
     }
 

@@ -97,6 +97,26 @@ class FrostParams:
         }
 
 
+def params_from_plan(plan: dict[str, Any]) -> FrostParams:
+    """Inverse of :meth:`FrostParams.as_plan`: what the parity job reads back from build-report.json."""
+    return FrostParams(
+        visible=ChannelRates(**plan["visible"]),
+        tilt=ChannelRates(**plan["tilt"]),
+        softness=plan["softness"],
+        seed=plan["seed"],
+        diffusivity=plan["diffusivity"],
+        history_scale=plan["historyScale"],
+        policy=plan["policy"],
+        tile_size=plan["tileSize"],
+        idle_when_converged=plan["idleWhenConverged"],
+        tolerance=plan["tolerance"],
+        max_interval=plan["maxInterval"],
+        discontinuity=plan["discontinuity"],
+        resize_policy=plan["resizePolicy"],
+        max_steps=plan["maxSteps"],
+    )
+
+
 def frost_params(spec: FrostEffectSpec) -> FrostParams:
     return FrostParams(
         visible=channel_rates(spec.history.visible, spec.brush.radius),

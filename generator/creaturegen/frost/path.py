@@ -23,8 +23,9 @@ def stroke_point(s: float) -> tuple[float, float]:
     return 0.15 + 0.7 * s, 0.5 + 0.22 * math.sin(2.0 * math.pi * s)
 
 
-def conformance_segments() -> list[Segment]:
-    count = round(STROKE_SECONDS * POINTER_HZ)
+def conformance_segments(slowdown: int = 1) -> list[Segment]:
+    """The stroke; ``slowdown`` > 1 draws the same shape that many times slower (for pictures)."""
+    count = round(STROKE_SECONDS * POINTER_HZ) * slowdown
     segments = []
     for k in range(count):
         s0, s1 = k / count, (k + 1) / count

@@ -58,7 +58,7 @@ BLUR_SIGMA = 3.0
 BLUR_EPSILON = 1e-4
 
 #: Frost coverage between crystals: a haze floor so the pane never shows clear gaps inside frost.
-HAZE = 0.3
+HAZE = 0.6
 
 #: The history memory the README quotes is for this drawing buffer (the seed's reference size).
 REFERENCE_DRAWING_BUFFER = (1920, 1080)

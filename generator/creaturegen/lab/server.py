@@ -130,9 +130,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     args = parser.parse_args(argv)
     server = make_server(args.root, args.host, args.port, {"out": args.out})
     base = f"http://{args.host}:{server.server_address[1]}/"
-    print(
-        f"==> serving {Path(args.root).resolve()} at {base}; packages: {Path(args.out).resolve()} at /out/"
-    )
+    print(f"==> serving {Path(args.root).resolve()} at {base}; packages: {Path(args.out).resolve()} at /out/")
     print(f"    {base}smoke.html  WebGPU smoke page")
     print(f"    {base}frost.html?pkg=<slug>  a built frost package, e.g. after `make build EXAMPLE=...`")
     print("    Ctrl-C stops the server", flush=True)

@@ -5,9 +5,12 @@
 // alpha with an epsilon guard (transparent texels do not darken their neighbours), and both passes are
 // exposed as texture nodes so the debug views can show each one.
 import { NodeMaterial, QuadMesh, RenderTarget, RendererUtils, TempNode, NodeUpdateType, HalfFloatType, Vector2 } from 'three/webgpu';
-import { Fn, float, passTexture, uniform, uv, vec2, vec4, max } from 'three/tsl';
+import { Fn, float, passTexture, texture, uniform, uv, vec2, vec4, max } from 'three/tsl';
 
-const quad = new QuadMesh();
+// One quad per pass: re-pointing a single QuadMesh at another material every frame rebuilt both
+// pipelines each frame (measured: two createRenderPipeline calls per frame).
+const verticalQuad = new QuadMesh();
+const horizontalQuad = new QuadMesh();
 let rendererState;
 
 /** Normalised one-sided Gaussian weights w[0..radius] with w[0] + 2·Σ w[i>0] = 1. */
@@ -58,12 +61,12 @@ export class SeparableBlurNode extends TempNode {
     rendererState = RendererUtils.resetRendererState(renderer, rendererState);
     const image = this.textureNode.value.image;
     this.setSize(image.width, image.height);
-    quad.material = this._verticalMaterial;
+    verticalQuad.material = this._verticalMaterial;
     renderer.setRenderTarget(this._verticalRT);
-    quad.render(renderer);
-    quad.material = this._horizontalMaterial;
+    verticalQuad.render(renderer);
+    horizontalQuad.material = this._horizontalMaterial;
     renderer.setRenderTarget(this._horizontalRT);
-    quad.render(renderer);
+    horizontalQuad.render(renderer);
     RendererUtils.restoreRendererState(renderer, rendererState);
   }
 
@@ -73,7 +76,7 @@ export class SeparableBlurNode extends TempNode {
     const invSize = this._invSize;
     return Fn(() => {
       const coord = uv();
-      const step = vec2(direction).mul(invSize);
+      const step = vec2(direction[0], direction[1]).mul(invSize);
       const c0 = source.sample(coord);
       const rgb = c0.rgb.mul(c0.a).mul(weights[0]).toVar();
       const alpha = c0.a.mul(weights[0]).toVar();
@@ -94,9 +97,9 @@ export class SeparableBlurNode extends TempNode {
     this._verticalMaterial.needsUpdate = true;
     this._horizontalMaterial ??= new NodeMaterial();
     this._horizontalMaterial.name = 'frost.blur.horizontal';
-    const vertical = passTexture(this, this._verticalRT.texture);
-    vertical.uvNode = null;
-    this._horizontalMaterial.fragmentNode = this._pass(vertical, [1, 0], builder);
+    // A plain texture node, not passTexture(this, …): a pass texture builds this node again inside the
+    // horizontal material, whose setup would then flag both materials for a rebuild every frame.
+    this._horizontalMaterial.fragmentNode = this._pass(texture(this._verticalRT.texture), [1, 0], builder);
     this._horizontalMaterial.needsUpdate = true;
     return this.horizontalNode;
   }

@@ -1,0 +1,73 @@
+"""Frost parity through Playwright: every example package on WebGPU (SwiftShader) against the numpy
+reference, with every gate of creaturegen.lab.frost_parity; plus a proof that the job catches a wrong
+GPU formula. Fails (never skips) when the browser or node_modules is missing."""
+
+from __future__ import annotations
+
+import json
+import shutil
+from pathlib import Path
+
+import pytest
+
+from conftest import EXAMPLES, run_cli
+from creaturegen.lab.frost_parity import run_frost_parity
+from creaturegen.spec import slugify
+
+FROST_EXAMPLES = sorted((EXAMPLES / "frost").glob("*.json"))
+
+
+@pytest.fixture(scope="module")
+def built(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Path]:
+    out = tmp_path_factory.mktemp("frost-out")
+    packages = {}
+    for spec in FROST_EXAMPLES:
+        result = run_cli("build", str(spec), "-o", str(out))
+        assert result.returncode == 0, result.stderr
+        slug = slugify(json.loads(spec.read_text())["name"])
+        packages[spec.stem] = out / slug
+    return packages
+
+
+def describe(report: dict[str, object]) -> str:
+    gates = report["gates"]
+    assert isinstance(gates, list)
+    return "\n".join(
+        f"{g['status']:4} {g['name']}: {g['value']} (<= {g['threshold']} {g['unit']})" for g in gates
+    )
+
+
+@pytest.mark.browser
+@pytest.mark.parametrize("example", [p.stem for p in FROST_EXAMPLES])
+def test_frost_package_passes_every_parity_gate(built: dict[str, Path], example: str) -> None:
+    package = built[example]
+    report = run_frost_parity(package)
+    written = json.loads((package / "parity" / "report.json").read_text())
+    assert written["status"] == ("pass" if report.passed else "fail")
+    assert report.passed, describe(written)
+    names = {g["name"] for g in written["gates"]}
+    assert {
+        "GPU vs numpy history at 30 FPS",
+        "GPU vs numpy history at 120 FPS",
+        "GPU validation errors",
+    } <= names
+    assert (package / "parity" / "final.png").stat().st_size > 1000
+    assert len(list((package / "parity").glob("view-*.png"))) == len(written["measurements"]["debugViews"])
+
+
+@pytest.mark.browser
+def test_parity_job_catches_a_wrong_gpu_decay_rate(built: dict[str, Path], tmp_path: Path) -> None:
+    # Same package, but the runtime's plan says the visible channel decays 10 % faster than the spec:
+    # the GPU now runs a different law than the numpy reference, and the history gate must fail.
+    source = built["frost-budgeted"]
+    broken = tmp_path / source.name
+    shutil.copytree(source, broken)
+    plan = broken / "core" / "plan.js"
+    report = json.loads((source / "build-report.json").read_text())
+    decay = report["params"]["visible"]["decay"]
+    text = plan.read_text()
+    assert f'"decay": {decay!r}' in text
+    plan.write_text(text.replace(f'"decay": {decay!r}', f'"decay": {decay * 1.1!r}', 1))
+    result = run_frost_parity(broken, groups=("history",))
+    failed = [g["name"] for g in result.gates if g["status"] == "fail"]
+    assert any(name.startswith("GPU vs numpy history") for name in failed), describe(result.as_dict())

@@ -1,0 +1,605 @@
+"""The frost history's Python side: closed-form law, brush, timeline, tile scheduler, numpy reference and the
+quantisation gate that picks the history storage format."""
+
+from __future__ import annotations
+
+import dataclasses
+import itertools
+import math
+from functools import cache
+
+import numpy as np
+import pytest
+
+from conftest import EXAMPLES
+from creaturegen.frost import formats, law, path
+from creaturegen.frost.brush import Segment, capsule_distance, coverage, pcg_hash, texel_noise
+from creaturegen.frost.formats import HALF_FLOAT_TOLERANCE, FormatGate, choose_format, measure_format
+from creaturegen.frost.params import DIFFUSION_STABILITY, FrostParams, frost_params
+from creaturegen.frost.reference import STATE_CHANNELS, FrostReference, remap_bilinear
+from creaturegen.frost.schedule import TileScheduler, diffusion_substeps
+from creaturegen.frost.timeline import Step, chunk_steps, classify_interval, split_interval, validate_segment
+from creaturegen.spec import FrostEffectSpec, load_spec
+
+FROST_EXAMPLES = ("frost-full", "frost-balanced", "frost-budgeted")
+#: Small on purpose: every property tested here is per texel, not per grid size.
+GRID = (48, 32)
+
+
+@cache
+def params_of(example: str) -> FrostParams:
+    spec = load_spec(EXAMPLES / "frost" / f"{example}.json")
+    assert isinstance(spec, FrostEffectSpec)
+    return frost_params(spec)
+
+
+def replay_states(params: FrostParams, fps: int, storage: str = "float64") -> tuple[FrostReference, dict]:
+    """Replay the conformance path; also snapshot the state channels at the instants k/30 s."""
+    reference = FrostReference(params, *GRID, storage)  # type: ignore[arg-type]
+    for segment in path.conformance_segments():
+        reference.queue(segment)
+    snapshots = {}
+    for k, (previous, current) in enumerate(itertools.pairwise(path.frame_instants(fps)), start=1):
+        reference.update(previous, current)
+        if (k * 30) % fps == 0:
+            snapshots[k * 30 // fps] = reference.state[..., STATE_CHANNELS].copy()
+    return reference, snapshots
+
+
+# --------------------------------------------------------------------------------------------------- law
+
+
+def test_law_two_half_steps_equal_one_step() -> None:
+    rng = np.random.default_rng(1)
+    x = rng.uniform(0.0, 1.0, 500)
+    b = rng.uniform(0.0, 1.0, 500)
+    for decay, fill, dt in zip(
+        rng.uniform(0, 3, 20), rng.uniform(0, 8, 20), rng.uniform(0, 0.2, 20), strict=True
+    ):
+        once = law.advance(x, b, dt, decay, fill)
+        twice = law.advance(law.advance(x, b, dt / 2, decay, fill), b, dt / 2, decay, fill)
+        np.testing.assert_allclose(twice, once, rtol=0, atol=1e-15)
+        assert np.any(once != x)
+
+
+def test_law_reaches_equilibrium() -> None:
+    x = np.linspace(0.0, 1.0, 11)
+    decay, fill, b = 0.7, 3.0, 0.4
+    expected = fill * b / (decay + fill * b)
+    np.testing.assert_allclose(law.advance(x, b, 200.0, decay, fill), expected, rtol=0, atol=1e-14)
+
+
+def test_law_zero_rate_keeps_state_exactly() -> None:
+    x = np.random.default_rng(2).uniform(0.0, 1.0, 100)
+    out = law.advance(x, 0.0, 5.0, 0.0, 4.0)
+    np.testing.assert_array_equal(out, x)
+    assert not np.any(np.isnan(out))
+
+
+def test_law_no_decay_with_coverage_tends_to_one() -> None:
+    x = np.array([0.0, 0.3, 0.9])
+    np.testing.assert_allclose(law.advance(x, 0.5, 100.0, 0.0, 2.0), 1.0, rtol=0, atol=1e-12)
+    # and it moves towards 1 monotonically
+    short = law.advance(x, 0.5, 0.1, 0.0, 2.0)
+    assert np.all(short > x)
+    assert np.all(short < 1.0)
+
+
+def test_law_pure_decay() -> None:
+    rng = np.random.default_rng(3)
+    x = rng.uniform(0.0, 1.0, 100)
+    for decay, dt in ((0.16, 0.033), (1.05, 0.5), (3.0, 2.0)):
+        np.testing.assert_allclose(law.advance(x, 0.0, dt, decay, 5.3), x * math.exp(-decay * dt), rtol=1e-15)
+
+
+# ------------------------------------------------------------------------------------------------- brush
+
+
+def pcg_reference(value: int) -> int:
+    """PCG-RXS-M-XS in plain Python integers, masked to 32 bits after every wrapping operation."""
+    state = (value * 747796405 + 2891336453) & 0xFFFFFFFF
+    word = (((state >> ((state >> 28) + 4)) ^ state) * 277803737) & 0xFFFFFFFF
+    return ((word >> 22) ^ word) & 0xFFFFFFFF
+
+
+def test_pcg_hash_matches_integer_reference() -> None:
+    rng = np.random.default_rng(4)
+    values = [0, 1, 2, 0xFFFFFFFF, 0x80000000, 0x68E31DA4, *rng.integers(0, 2**32, 300).tolist()]
+    hashed = pcg_hash(np.array(values, dtype=np.uint32))
+    assert hashed.dtype == np.uint32
+    assert hashed.tolist() == [pcg_reference(v) for v in values]
+    assert len(set(hashed.tolist())) == len(set(values))
+
+
+def test_texel_noise_range_and_float32_exact() -> None:
+    for channel in (0, 1):
+        noise = texel_noise(40, 24, seed=11, channel=channel)
+        assert noise.shape == (24, 40)
+        assert noise.min() >= 0.0
+        assert noise.max() < 1.0
+        scaled = noise * 2.0**24
+        np.testing.assert_array_equal(scaled, np.floor(scaled))
+        np.testing.assert_array_equal(noise.astype(np.float32).astype(np.float64), noise)
+        assert noise.std() > 0.2  # roughly uniform, not constant
+    assert not np.array_equal(texel_noise(40, 24, 11, 0), texel_noise(40, 24, 11, 1))
+    assert not np.array_equal(texel_noise(40, 24, 11, 0), texel_noise(40, 24, 12, 0))
+
+
+def test_texel_noise_matches_integer_reference() -> None:
+    seed, salt = 11, 0x68E31DA4
+    noise = texel_noise(6, 5, seed, 0)
+    salted = pcg_reference(seed ^ salt)
+    for j in range(5):
+        for i in range(6):
+            col = pcg_reference((i + salted) & 0xFFFFFFFF)
+            assert noise[j, i] == (pcg_reference((j + col) & 0xFFFFFFFF) >> 8) / 2**24
+
+
+def test_capsule_distance_is_aspect_corrected() -> None:
+    width, height = 64, 32
+    i0, j0 = 30, 15
+    centre = ((i0 + 0.5) / width, (j0 + 0.5) / height)
+    distance = capsule_distance(Segment(0.0, 1.0, centre, centre), width, height)
+    assert distance[j0, i0] == pytest.approx(0.0, abs=1e-15)
+    for k in range(1, 10):
+        horizontal, vertical = distance[j0, i0 + k], distance[j0 + k, i0]
+        assert horizontal == pytest.approx(vertical, abs=1e-14), k
+        assert vertical == pytest.approx(k / height, abs=1e-14)
+        assert distance[j0 - k, i0 - k] == pytest.approx(math.hypot(k, k) / height, abs=1e-14)
+
+
+def test_capsule_distance_of_a_swept_segment() -> None:
+    width, height = 60, 30
+    start, end = (0.25, 0.5), (0.75, 0.5)
+    distance = capsule_distance(Segment(0.0, 1.0, start, end), width, height)
+    row = int(0.5 * height)  # texel centre v = 15.5/30, just below the segment
+    offset = (row + 0.5) / height - 0.5
+    inside = [i for i in range(width) if 0.25 <= (i + 0.5) / width <= 0.75]
+    np.testing.assert_allclose(distance[row, inside], abs(offset), atol=1e-14)
+    # beyond the end cap the distance grows like a disc around the end point
+    i = width - 1
+    expected = math.hypot(((i + 0.5) / width - 0.75) * width / height, offset)
+    assert distance[row, i] == pytest.approx(expected, abs=1e-14)
+
+
+def test_coverage_radius_centre_and_average_pressure() -> None:
+    width, height, radius, softness = 64, 32, 0.2, 0.5
+    thinning = 0.3 * texel_noise(width, height, 5, 0)
+    i0, j0 = 20, 16
+    centre = ((i0 + 0.5) / width, (j0 + 0.5) / height)
+    point = Segment(0.0, 1.0, centre, centre, pressure0=0.2, pressure1=0.8)
+    cov = coverage(point, width, height, radius, softness, thinning)
+    distance = capsule_distance(point, width, height)
+    assert np.all(cov[distance >= radius] == 0.0)
+    assert np.count_nonzero(distance >= radius) > 0
+    assert cov[j0, i0] == pytest.approx(0.5 * (1.0 - thinning[j0, i0]), abs=1e-15)
+    inner = distance <= radius * (1.0 - softness)
+    np.testing.assert_allclose(cov[inner], 0.5 * (1.0 - thinning[inner]), atol=1e-15)
+    assert np.all(cov >= 0.0)
+    assert np.all(cov <= 1.0)
+    # the average of the two pressures holds over the whole capsule, at both ends alike
+    end = ((i0 + 10.5) / width, (j0 + 0.5) / height)
+    swept = coverage(Segment(0.0, 1.0, centre, end, 0.0, 1.0), width, height, radius, softness, thinning)
+    assert swept[j0, i0] == pytest.approx(0.5 * (1.0 - thinning[j0, i0]), abs=1e-15)
+    assert swept[j0, i0 + 10] == pytest.approx(0.5 * (1.0 - thinning[j0, i0 + 10]), abs=1e-15)
+
+
+# ---------------------------------------------------------------------------------------------- timeline
+
+
+@pytest.mark.parametrize(
+    ("previous", "current", "expected"),
+    [
+        (1.0, 1.0, "none"),
+        (0.0, 0.0, "none"),
+        (1.0, 0.5, "discontinuity"),
+        (math.nan, 1.0, "discontinuity"),
+        (0.0, math.nan, "discontinuity"),
+        (0.0, math.inf, "discontinuity"),
+        (-math.inf, 0.0, "discontinuity"),
+        (0.0, 1.5, "discontinuity"),
+        (0.0, 1.0, "advance"),
+        (2.0, 2.0 + 1 / 60, "advance"),
+    ],
+)
+def test_classify_interval(previous: float, current: float, expected: str) -> None:
+    assert classify_interval(previous, current, 1.0) == expected
+
+
+def test_split_interval_cuts_at_segment_boundaries() -> None:
+    a = Segment(0.1, 0.2, (0.1, 0.1), (0.2, 0.1))
+    b = Segment(0.25, 0.3, (0.2, 0.1), (0.3, 0.1))
+    c = Segment(0.3, 0.5, (0.3, 0.1), (0.4, 0.1))
+    steps = split_interval(0.15, 0.4, [a, b, c])
+    assert [s.segment for s in steps] == [a, None, b, c]
+    assert [s.dt for s in steps] == pytest.approx([0.05, 0.05, 0.05, 0.1], abs=1e-15)
+    assert math.fsum(s.dt for s in steps) == pytest.approx(0.4 - 0.15, abs=1e-15)
+    # an interval inside one segment is a single step of that segment
+    inner = split_interval(0.35, 0.45, [a, b, c])
+    assert len(inner) == 1
+    assert inner[0].segment == c
+    assert inner[0].dt == pytest.approx(0.1, abs=1e-15)
+    # no segments at all: pure decay
+    assert split_interval(0.0, 0.5, []) == [Step(0.5, None)]
+
+
+def test_split_interval_conformance_path_sums_exactly() -> None:
+    segments = path.conformance_segments()
+    for fps in path.FRAME_RATES:
+        for previous, current in itertools.pairwise(path.frame_instants(fps)):
+            steps = split_interval(previous, current, segments)
+            assert all(s.dt > 0 for s in steps)
+            assert math.fsum(s.dt for s in steps) == pytest.approx(current - previous, abs=1e-15)
+            start = previous
+            for step in steps:
+                end = start + step.dt
+                middle = 0.5 * (start + end)
+                covering = [g for g in segments if g.t0 <= middle < g.t1]
+                if step.dt < 1e-12:
+                    pass  # a sliver between a frame instant and a boundary one ulp away: either side is right
+                elif step.segment is None:
+                    assert not covering, (fps, start)
+                else:
+                    assert covering == [step.segment], (fps, start)
+                    assert step.segment.t0 <= start + 1e-12
+                    assert end <= step.segment.t1 + 1e-12
+                start = end
+
+
+def test_chunk_steps_sizes() -> None:
+    steps = [Step(0.01, None)] * 35
+    assert [len(c) for c in chunk_steps(steps, 16)] == [16, 16, 3]
+    assert [len(c) for c in chunk_steps(steps[:16], 16)] == [16]
+    assert chunk_steps([], 16) == []
+    assert [s for chunk in chunk_steps(steps, 7) for s in chunk] == steps
+
+
+def test_validate_segment() -> None:
+    good = Segment(0.0, 0.1, (0.1, 0.1), (0.2, 0.2), 0.5, 1.0)
+    assert validate_segment(good, None) is None
+    assert validate_segment(good, 0.0) is None
+    assert "before the previous" in str(validate_segment(good, 0.05))
+    assert "before it starts" in str(validate_segment(Segment(0.2, 0.1, (0, 0), (0, 0)), None))
+    assert "finite" in str(validate_segment(Segment(0.0, math.nan, (0, 0), (0, 0)), None))
+    assert "finite" in str(validate_segment(Segment(0.0, 0.1, (math.inf, 0), (0, 0)), None))
+    assert "pressures" in str(validate_segment(Segment(0.0, 0.1, (0, 0), (0, 0), 1.5, 1.0), None))
+    assert "pressures" in str(validate_segment(Segment(0.0, 0.1, (0, 0), (0, 0), 1.0, -0.1), None))
+
+
+# ---------------------------------------------------------------------------------------------- schedule
+
+
+def test_full_field_idles_after_convergence() -> None:
+    params = params_of("frost-full")
+    assert params.policy == "full-field"
+    assert params.idle_when_converged
+    scheduler = TileScheduler(params, 48, 32)
+    stroke = Segment(0.0, 0.1, (0.3, 0.5), (0.6, 0.5))
+    first = scheduler.plan([Step(0.1, stroke)], 0.1, 0)
+    assert first.update == (0,)
+    assert first.retire == ()
+    updates, retires = [], []
+    for _ in range(200):
+        plan = scheduler.plan([Step(1.0, None)], 1.0, 0)
+        updates.append(plan.update)
+        retires.append(plan.retire)
+    retired_at = [k for k, r in enumerate(retires) if r]
+    assert len(retired_at) == 1
+    k = retired_at[0]
+    assert retires[k] == (0,)
+    # the slower channel needs ln(1/tol)/λ seconds to fall under the tolerance
+    slowest = min(c.decay for c in params.channels)
+    assert k + 1 == math.ceil(math.log(1.0 / params.tolerance) / slowest - 1e-9)
+    assert all(u == (0,) for u in updates[:k])
+    assert all(u == () for u in updates[k:])
+    # a brush wakes it again
+    assert scheduler.plan([Step(0.1, stroke)], 0.1, 0).update == (0,)
+
+
+def test_full_field_reference_idles_with_zero_dispatches() -> None:
+    params = dataclasses.replace(params_of("frost-full"), diffusivity=0.0)
+    reference = FrostReference(params, 16, 8)
+    reference.queue(Segment(0.0, 0.1, (0.2, 4.5 / 8), (0.8, 4.5 / 8)))  # along a row of texel centres
+    reference.update(0.0, 0.1)
+    assert reference.state[..., 0].max() > 0.1
+    instants = [0.1 + 0.5 * k for k in range(220)]
+    reports = [reference.update(a, b) for a, b in itertools.pairwise(instants)]
+    assert reference.counters.discontinuities == 0
+    retired = [k for k, r in enumerate(reports) if r.retired_tiles]
+    assert len(retired) == 1
+    after = reports[retired[0] + 1 :]
+    assert after
+    assert all(r.update_tiles == 0 and r.dispatches == 0 and r.texels == 0 for r in after)
+    assert not np.any(reference.state)
+
+
+def test_full_field_without_idle_updates_every_frame() -> None:
+    params = dataclasses.replace(params_of("frost-full"), idle_when_converged=False)
+    scheduler = TileScheduler(params, 48, 32)
+    for _ in range(150):
+        plan = scheduler.plan([Step(1.0, None)], 1.0, 0)
+        assert plan.update == (0,)
+        assert plan.retire == ()
+
+
+def test_dirty_tiles_update_only_near_the_stroke() -> None:
+    params = params_of("frost-balanced")
+    assert params.policy == "dirty-tiles"
+    width, height = 128, 64
+    scheduler = TileScheduler(params, width, height)
+    assert (scheduler.tiles_x, scheduler.tiles_y) == (8, 4)
+    stroke = Segment(0.0, 0.05, (0.1, 0.2), (0.15, 0.2))
+    plan = scheduler.plan([Step(0.05, stroke)], 0.05, 0)
+    assert plan.update
+    assert len(plan.update) < 8 * 4 // 2
+    mask = plan.mask(plan.update, width, height)
+    thinning = np.zeros((height, width))
+    for channel in params.channels:
+        reached = coverage(stroke, width, height, channel.radius, params.softness, thinning) > 0
+        assert np.all(mask[reached]), "a tile the brush reaches was not updated"
+    # every updated tile lies within the brush reach (plus one texel) of the stroke
+    distance = capsule_distance(stroke, width, height)
+    for tile in plan.update:
+        tile_mask = plan.mask((tile,), width, height)
+        assert distance[tile_mask].min() <= params.brush_reach + 1.5 / height, tile
+    assert len(plan.update) == len(set(plan.update))
+
+
+def test_dirty_tiles_retire_once_per_tile() -> None:
+    params = params_of("frost-balanced")
+    scheduler = TileScheduler(params, 128, 64)
+    segments = [
+        Segment(0.05 * k, 0.05 * (k + 1), (0.1 + 0.1 * k, 0.3), (0.2 + 0.1 * k, 0.5)) for k in range(6)
+    ]
+    touched: set[int] = set()
+    for segment in segments:
+        touched.update(scheduler.plan([Step(0.05, segment)], 0.05, 0).update)
+    retired: list[int] = []
+    for _ in range(40):
+        plan = scheduler.plan([Step(1.0, None)], 1.0, 0)
+        assert not set(plan.retire) & set(plan.update)
+        retired.extend(plan.retire)
+    assert sorted(retired) == sorted(touched)
+    assert len(retired) == len(set(retired))
+    assert not scheduler.live.any()
+
+
+@pytest.mark.parametrize("example", ["frost-balanced", "frost-full"])
+def test_tile_bounds_never_underestimate(example: str) -> None:
+    """Dirty tiles vs an every-texel-every-frame run: no content ever lives outside the live tiles."""
+    params = dataclasses.replace(params_of(example), policy="dirty-tiles", tile_size=8)
+    exhaustive = dataclasses.replace(params, policy="full-field", idle_when_converged=False)
+    width, height = 48, 32
+    dirty = FrostReference(params, width, height)
+    full = FrostReference(exhaustive, width, height)
+    for segment in path.conformance_segments():
+        dirty.queue(segment)
+        full.queue(segment)
+    geometry = dirty.scheduler
+    assert (geometry.tile_width, geometry.tile_height, geometry.tiles_x, geometry.tiles_y) == (8, 8, 6, 4)
+    instants = path.frame_instants(60, duration=1.5)
+    live_counts = []
+    for previous, current in itertools.pairwise(instants):
+        dirty_report = dirty.update(previous, current)
+        full.update(previous, current)
+        scheduler = dirty.scheduler
+        live = scheduler.live
+        live_counts.append(dirty_report.update_tiles)
+        mask = np.kron(live, np.ones((8, 8), dtype=bool))
+        assert not np.any(dirty.state[~mask]), current
+        truth = full.state[..., STATE_CHANNELS]
+        for ty, tx in itertools.product(range(4), range(6)):
+            block = truth[ty * 8 : ty * 8 + 8, tx * 8 : tx * 8 + 8]
+            for index in range(2):
+                assert block[..., index].max() <= scheduler.bounds[index, ty, tx] + 1e-12, (current, ty, tx)
+            if not live[ty, tx]:
+                assert block.max() <= params.tolerance
+        np.testing.assert_allclose(dirty.state[..., STATE_CHANNELS], truth, rtol=0, atol=params.tolerance)
+    assert max(live_counts) > 0
+    if params.diffusivity == 0.0:
+        # without diffusion nothing spreads: the tiles far from the stroke are never dispatched
+        assert max(live_counts) < 24
+
+
+def test_diffusion_substeps_stable_and_minimal() -> None:
+    assert diffusion_substeps(0.0, 1.0, 1080) == 0
+    assert diffusion_substeps(1e-5, 0.0, 1080) == 0
+    rng = np.random.default_rng(6)
+    cases = [(2e-5, 1 / 30, 1080), (2e-5, 1.0, 1080), (1e-3, 1 / 60, 540), (0.25, 1.0, 1)]
+    random = (10 ** rng.uniform(-7, -2, 200), rng.uniform(0.001, 1.0, 200), rng.integers(8, 2160, 200))
+    cases += list(zip(*random, strict=True))
+    for diffusivity, dt, height in cases:
+        n = diffusion_substeps(float(diffusivity), float(dt), int(height))
+        number = diffusivity * dt * height * height
+        assert n >= 1
+        assert number / n <= DIFFUSION_STABILITY, (diffusivity, dt, height, n)
+        assert diffusivity * (dt / n) * height * height <= DIFFUSION_STABILITY * (1 + 1e-15)
+        if n > 1:
+            assert number / (n - 1) > DIFFUSION_STABILITY, (diffusivity, dt, height, n)
+
+
+# --------------------------------------------------------------------------------------------- reference
+
+
+@pytest.mark.parametrize("example", FROST_EXAMPLES)
+def test_frame_rate_independence_without_diffusion(example: str) -> None:
+    params = dataclasses.replace(params_of(example), diffusivity=0.0)
+    runs = {fps: replay_states(params, fps) for fps in path.FRAME_RATES}
+    final30, snaps30 = runs[30]
+    assert final30.state[..., 0].max() > 0.05  # the stroke left a mark
+    assert final30.counters.discontinuities == 0
+    for fps in (60, 120):
+        final, snaps = runs[fps]
+        worst = float(np.abs(final.state - final30.state).max())
+        assert worst <= 1e-12, f"{example} {fps} FPS final state differs from 30 FPS by {worst:.3g}"
+        assert snaps.keys() == snaps30.keys()
+        for k, snap in snaps30.items():
+            diff = float(np.abs(snaps[k] - snap).max())
+            assert diff <= 1e-12, f"{example} {fps} FPS at {k}/30 s differs by {diff:.3g}"
+
+
+def test_diffusion_operator_splitting_is_small() -> None:
+    params = params_of("frost-full")
+    assert params.diffusivity > 0
+    slow = replay_states(params, 30)[0].state
+    fast = replay_states(params, 120)[0].state
+    difference = float(np.abs(slow - fast).max())
+    assert 0.0 < difference < 1e-3, f"30 vs 120 FPS with diffusion differ by {difference:.3g}"
+
+
+def test_float16_storage_is_representable() -> None:
+    reference, _ = replay_states(params_of("frost-balanced"), 60, "float16")
+    state = reference.state
+    assert state.max() > 0.05
+    np.testing.assert_array_equal(state.astype(np.float16).astype(np.float64), state)
+    exact, _ = replay_states(params_of("frost-balanced"), 60, "float64")
+    assert not np.array_equal(exact.state, state)
+    assert np.abs(exact.state - state).max() < 0.01
+
+
+def stroked_reference(discontinuity: str) -> FrostReference:
+    params = dataclasses.replace(
+        params_of("frost-full"),
+        discontinuity=discontinuity,  # type: ignore[arg-type]
+        diffusivity=0.0,
+    )
+    reference = FrostReference(params, *GRID)
+    reference.queue(Segment(0.0, 0.2, (0.2, 0.5), (0.8, 0.5)))
+    reference.queue(Segment(0.3, 0.4, (0.2, 0.2), (0.8, 0.2)))
+    reference.update(0.0, 0.2)
+    assert reference.state[..., 0].max() > 0.1
+    return reference
+
+
+@pytest.mark.parametrize("bad", [0.1, math.nan, math.inf, 5.0])
+def test_discontinuity_reset_clears(bad: float) -> None:
+    reference = stroked_reference("reset")
+    report = reference.update(0.2, bad)
+    assert report.decision == "discontinuity"
+    assert not np.any(reference.state)
+    assert reference.counters.discontinuities == 1
+    assert reference.counters.frames == 2
+    assert reference.pending == []
+    assert not reference.scheduler.live.any()
+
+
+def test_discontinuity_freeze_keeps_state() -> None:
+    reference = stroked_reference("freeze")
+    before = reference.state.copy()
+    report = reference.update(0.2, math.nan)
+    assert report.decision == "discontinuity"
+    np.testing.assert_array_equal(reference.state, before)
+    assert reference.counters.discontinuities == 1
+    assert reference.pending == []  # the queued stroke belonged to the dropped interval
+    # after the freeze, pure decay continues from the kept state
+    reference.update(10.0, 10.5)
+    np.testing.assert_allclose(
+        reference.state[..., 0], before[..., 0] * math.exp(-reference.params.visible.decay * 0.5), rtol=1e-12
+    )
+
+
+def test_equal_instants_change_nothing() -> None:
+    reference = stroked_reference("reset")
+    before = reference.state.copy()
+    counters = dataclasses.replace(reference.counters, history=list(reference.counters.history))
+    pending = list(reference.pending)
+    report = reference.update(0.2, 0.2)
+    assert report.decision == "none"
+    assert report.dispatches == 0
+    np.testing.assert_array_equal(reference.state, before)
+    assert reference.counters == counters
+    assert reference.pending == pending
+
+
+def test_resize_clear_zeros() -> None:
+    params = dataclasses.replace(params_of("frost-full"), resize_policy="clear")
+    reference = FrostReference(params, *GRID)
+    reference.queue(Segment(0.0, 0.2, (0.2, 0.5), (0.8, 0.5)))
+    reference.update(0.0, 0.2)
+    assert reference.state.max() > 0.1
+    reference.resize(40, 20)
+    assert reference.state.shape == (20, 40, 4)
+    assert not np.any(reference.state)
+    assert not reference.scheduler.live.any()
+
+
+def linear_ramp(width: int, height: int) -> np.ndarray:
+    u = (np.arange(width) + 0.5) / width
+    v = (np.arange(height) + 0.5) / height
+    ramp = 0.1 + 0.5 * u[None, :] + 0.3 * v[:, None]
+    return np.repeat(ramp[..., None], 4, axis=2) * np.array([1.0, 0.5, 0.25, 0.8])
+
+
+def test_remap_bilinear_of_linear_ramp_is_exact_inside() -> None:
+    old = linear_ramp(48, 32)
+    for width, height in ((96, 64), (30, 20), (61, 17)):
+        new = remap_bilinear(old, width, height)
+        expected = linear_ramp(width, height)
+        x = (np.arange(width) + 0.5) / width * 48 - 0.5
+        y = (np.arange(height) + 0.5) / height * 32 - 0.5
+        inside = ((y >= 0) & (y <= 31))[:, None] & ((x >= 0) & (x <= 47))[None, :]
+        assert inside.sum() > 0.8 * width * height
+        np.testing.assert_allclose(new[inside], expected[inside], rtol=0, atol=1e-14)
+
+
+def test_resize_preserve_remap_reproduces_ramp() -> None:
+    params = params_of("frost-full")
+    assert params.resize_policy == "preserve-remap"
+    reference = FrostReference(params, 48, 32)
+    reference.queue(Segment(0.0, 0.1, (0.3, 0.5), (0.6, 0.5)))
+    reference.update(0.0, 0.1)
+    reference.state = linear_ramp(48, 32)
+    reference.resize(96, 64)
+    expected = linear_ramp(96, 64)
+    interior = (slice(1, -1), slice(1, -1))
+    np.testing.assert_allclose(reference.state[interior], expected[interior], rtol=0, atol=1e-14)
+    assert reference.scheduler.live.all()
+    assert reference.scheduler.bounds.max() == 1.0
+
+
+# ----------------------------------------------------------------------------------------------- formats
+
+
+@cache
+def gate(example: str, fmt: str) -> FormatGate:
+    """measure_format is four replays; each (example, format) is measured once per test session."""
+    return measure_format(params_of(example), fmt)
+
+
+@pytest.fixture
+def cached_gates(monkeypatch: pytest.MonkeyPatch) -> None:
+    by_params = {params_of(name): name for name in FROST_EXAMPLES}
+    monkeypatch.setattr(formats, "measure_format", lambda params, fmt: gate(by_params[params], fmt))
+
+
+def test_measure_format_drift_on_frost_full() -> None:
+    half = gate("frost-full", "rgba16float")
+    single = gate("frost-full", "rgba32float")
+    assert half.drift > HALF_FLOAT_TOLERANCE, half
+    assert not half.passed
+    assert single.drift < HALF_FLOAT_TOLERANCE, single
+    assert single.passed
+    assert set(half.per_rate) == set(path.FRAME_RATES)
+    assert half.drift == max(half.per_rate.values())
+    assert half.as_dict()["status"] == "fail"
+    assert single.as_dict()["status"] == "pass"
+
+
+@pytest.mark.usefixtures("cached_gates")
+def test_choose_format_auto() -> None:
+    chosen, gates = choose_format(params_of("frost-full"), "auto")
+    assert chosen == "rgba32float"
+    assert [g.format for g in gates] == ["rgba16float", "rgba32float"]
+    chosen, gates = choose_format(params_of("frost-balanced"), "auto")
+    assert chosen == "rgba16float"
+    assert [g.format for g in gates] == ["rgba16float"]
+    assert gates[0].passed
+
+
+@pytest.mark.usefixtures("cached_gates")
+def test_choose_format_explicit_failure_is_an_error() -> None:
+    with pytest.raises(ValueError, match="auto"):
+        choose_format(params_of("frost-full"), "rgba16float")
+    chosen, gates = choose_format(params_of("frost-full"), "rgba32float")
+    assert chosen == "rgba32float"
+    assert [g.format for g in gates] == ["rgba32float"]
