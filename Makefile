@@ -13,7 +13,10 @@ VENV_PY := $(VENV)/bin/python
 VENV_STAMP := $(VENV)/.installed
 WEB_LAB := web_lab
 NODE_STAMP := $(WEB_LAB)/node_modules/.package-lock.json
-EXAMPLE ?= examples/lizard.json
+# The default example is a frost effect: its package is emitted end to end. Creature specs validate and
+# compile (inspect/probe), but their package emitter is not written yet (issue 5).
+EXAMPLE ?= examples/frost/frost-full.json
+FROST_EXAMPLES := $(wildcard examples/frost/*.json)
 LAB_HOST ?= 127.0.0.1
 LAB_PORT ?= 8765
 # Extra pytest arguments for local runs, e.g. PYTEST_ARGS='-k smoke'. CI leaves it empty: every test
@@ -22,11 +25,12 @@ PYTEST_ARGS ?=
 # Only folders that exist: git does not keep empty ones, and ruff fails on a missing path.
 LINT_PATHS := $(wildcard generator tests bench)
 
-.PHONY: help setup system-deps build test schemas lab bench clean distclean
+.PHONY: help setup system-deps build parity test schemas lab bench clean distclean
 
 help:
 	@echo "make setup    .venv + pip install -e '.[dev]', npm ci in $(WEB_LAB), chromium + lavapipe"
 	@echo "make build    creaturegen build \$$EXAMPLE (now $(EXAMPLE)) into out/"
+	@echo "make parity   build every frost example and run its parity job (out/<slug>/parity/)"
 	@echo "make test     ruff, ruff format --check, mypy, pytest (browser tests included)"
 	@echo "make schemas  export JSON Schemas into schemas/"
 	@echo "make lab      serve $(WEB_LAB)/ at http://$(LAB_HOST):$(LAB_PORT)/"
@@ -64,12 +68,20 @@ build: setup
 	@echo "==> creaturegen build $(EXAMPLE)"
 	$(VENV)/bin/creaturegen build $(EXAMPLE)
 
+SLUG_OF := $(VENV_PY) -c 'import json, sys; from creaturegen.spec import slugify; print(slugify(json.load(open(sys.argv[1]))["name"]))'
+
+parity: setup
+	@pkgs=""; for spec in $(FROST_EXAMPLES); do \
+	  echo "==> creaturegen build $$spec"; $(VENV)/bin/creaturegen build $$spec >/dev/null || exit 2; \
+	  pkgs="$$pkgs out/$$($(SLUG_OF) $$spec)"; done; \
+	$(VENV)/bin/creaturegen parity $$pkgs
+
 schemas: $(VENV_STAMP)
 	@echo "==> exporting JSON Schemas into schemas/"
 	$(VENV)/bin/creaturegen schema --out schemas
 
 lab: $(VENV_STAMP) $(NODE_STAMP)
-	$(VENV_PY) -m creaturegen.lab.server --root $(WEB_LAB) --host $(LAB_HOST) --port $(LAB_PORT)
+	$(VENV_PY) -m creaturegen.lab.server --root $(WEB_LAB) --out out --host $(LAB_HOST) --port $(LAB_PORT)
 
 bench: $(VENV_STAMP)
 	@echo "==> field benchmark into bench/results/field.json"

@@ -177,19 +177,37 @@ async function main() {
       await device.queue.onSubmittedWorkDone();
       return performance.now() - start;
     },
-    // bench helpers: the effect's blur node, found by wrapping its class's updateBefore for one render (lab
-    // code; the package is not modified). setBlurScale sets only that node's resolution scale, as setTier
-    // does (setTier puts the tier's scale back); the render here resizes the blur's two targets.
+    // bench helpers. three advances its node frame once per requestAnimationFrame tick, and the scene pass
+    // and the blur run once per node frame, so renders back to back in one task (timeFrames) redo only the
+    // composite. timeAnimationFrames runs one frame per tick, as an app's loop does, and sums each frame's
+    // ms from its update to its GPU completion (the wait for the tick is not counted).
+    async timeAnimationFrames(instants, { draw = true } = {}) {
+      let total = 0;
+      for (let i = 0; i + 1 < instants.length; i++) {
+        await new Promise((resolve) => requestAnimationFrame(resolve));
+        const start = performance.now();
+        effect.update(instants[i], instants[i + 1]);
+        if (draw) render();
+        await device.queue.onSubmittedWorkDone();
+        total += performance.now() - start;
+      }
+      return total;
+    },
+    // The effect's blur node, found by wrapping its class's updateBefore for one render (lab code; the
+    // package is not modified); sets only that node's resolution scale, as setTier does (setTier puts the
+    // tier's scale back). The second render, a tick later, resizes the blur's two targets.
     async setBlurScale(scale) {
       const { SeparableBlurNode } = await import(`/out/${slug}/tsl/separable-blur.js`);
       const proto = SeparableBlurNode.prototype;
       const original = proto.updateBefore;
       let node = null;
       proto.updateBefore = function captured(frame) { node = this; return original.call(this, frame); };
+      await new Promise((resolve) => requestAnimationFrame(resolve));
       try { render(); } finally { proto.updateBefore = original; }
       if (node === null) throw new Error('frost lab: the blur node did not run during render()');
       const previous = node.resolutionScale;
       node.resolutionScale = scale;
+      await new Promise((resolve) => requestAnimationFrame(resolve));
       render();
       await device.queue.onSubmittedWorkDone();
       return { previous, scale, size: [...node.size] };

@@ -108,9 +108,8 @@ def _build(args: argparse.Namespace) -> int:
         return EXIT_INVALID
     report = json.loads((folder / "build-report.json").read_text())
     for gate in report["gates"]:
-        print(
-            f"  gate {gate['name']}: {gate['value']:.3g} (threshold {gate['threshold']:.3g}) {gate['status']}"
-        )
+        verdict = "pass" if gate["status"] == "pass" else "fail, so this format is not used"
+        print(f"  gate {gate['name']}: {gate['value']:.3g} (threshold {gate['threshold']:.3g}) {verdict}")
     print(f"  history format {report['historyFormat']['historyFormat']}")
     print(f"wrote {folder}/")
     return EXIT_OK
@@ -232,7 +231,7 @@ def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(
         prog="creaturegen",
         description="Compile JSON creature and frost specs into Three.js r185 WebGPU/TSL npm packages.",
-        epilog="Exit codes: 0 ok, 1 a parity gate failed, 2 invalid spec or arguments (errors name the place).",
+        epilog="Exit codes: 0 ok, 1 a parity gate failed, 2 invalid spec or arguments (errors name it).",
     )
     parser.add_argument("--version", action="version", version=f"creaturegen {__version__}")
     commands = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")

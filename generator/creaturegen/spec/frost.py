@@ -175,6 +175,16 @@ class Structure(StrictModel):
     ridgeSharpness: Positive = 2.0
     normalStrength: NonNegative = 1.0
 
+    @field_validator("crystalScale")
+    @classmethod
+    def _cells_resolvable(cls, value: float, info: ValidationInfo) -> float:
+        resolution = info.data.get("resolution")
+        if resolution is not None and value > resolution / 4:
+            raise rule_error(
+                f"must be <= resolution / 4 ({number(resolution / 4)}): a crystal needs at least 4 texels"
+            )
+        return value
+
 
 class TimePolicy(StrictModel):
     """What a negative, NaN or too-long interval does: never a silent clamp."""
