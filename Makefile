@@ -34,7 +34,7 @@ help:
 	@echo "make test     ruff, ruff format --check, mypy, pytest (browser tests included)"
 	@echo "make schemas  export JSON Schemas into schemas/"
 	@echo "make lab      serve $(WEB_LAB)/ at http://$(LAB_HOST):$(LAB_PORT)/"
-	@echo "make bench    field benchmark (full graph vs candidates, analytic vs FD) into bench/results/field.json"
+	@echo "make bench    bench/results/field.json (candidates, analytic vs FD) and frost.json (tiers, tiles, idle)"
 	@echo "make clean    remove build output and caches; distclean also removes .venv and node_modules"
 
 # --- setup ------------------------------------------------------------------------------------
@@ -83,9 +83,11 @@ schemas: $(VENV_STAMP)
 lab: $(VENV_STAMP) $(NODE_STAMP)
 	$(VENV_PY) -m creaturegen.lab.server --root $(WEB_LAB) --out out --host $(LAB_HOST) --port $(LAB_PORT)
 
-bench: $(VENV_STAMP)
+bench: setup
 	@echo "==> field benchmark into bench/results/field.json"
 	$(VENV_PY) bench/field.py --out bench/results/field.json
+	@echo "==> frost benchmark (WebGPU on SwiftShader) into bench/results/frost.json"
+	$(VENV_PY) bench/frost.py --out bench/results/frost.json
 
 # --- checks -----------------------------------------------------------------------------------
 

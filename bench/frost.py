@@ -5,9 +5,9 @@ into a temporary folder by ``creaturegen build``, and every figure below is meas
 
 * **tiers** (``examples/frost/frost-full.json``, switched with ``setTier``, so the tier is the only
   variable): ms per frame of update-only frames (the conformance stroke, full-field policy,
-  ``timeFrames(draw=false)``), of update + render frames (``draw=true``), of render-only frames (every
-  ``update`` returns ``none``) and of the blur's two passes alone (the lab's ``timeBlurPasses``);
-  ``render_minus_blur`` is a difference of two medians (scene pass + composite + overhead).
+  ``timeFrames(draw=false)``), of update + render frames (``draw=true``) and of render-only frames (every
+  ``update`` returns ``none``), the last once at the tier's blur scale and once with the blur's targets
+  shrunk to 1x1 (the lab's ``setBlurScale``); their difference is the blur estimate.
 * **sparse**: two specs derived from ``examples/frost/frost-budgeted.json`` that differ only in
   ``update.policy`` (full-field vs dirty-tiles), built side by side; a small dab replayed on both, texels
   and dispatches per frame from the per-frame reports, ms per frame from ``timeFrames``.
@@ -45,7 +45,7 @@ from creaturegen.frost.params import scaled_size
 from creaturegen.frost.path import conformance_segments
 from creaturegen.frost.plan import BYTES_PER_TEXEL
 from creaturegen.lab.browser import READY_EXPRESSION, LabPage, launch_lab_page
-from creaturegen.lab.frost_session import FrostLab, segment_json
+from creaturegen.lab.frost_session import FrostLab
 from creaturegen.lab.server import serve
 
 REPO = Path(__file__).resolve().parents[1]
@@ -61,19 +61,36 @@ DAB_SECONDS = 0.1
 DAB_RADIUS = 0.01
 DAB_HZ = 240
 
+#: Two pages share one browser in the sparse section: neither may be throttled as a background tab.
+BROWSER_FLAGS = (
+    "--disable-background-timer-throttling",
+    "--disable-renderer-backgrounding",
+    "--disable-backgrounding-occluded-windows",
+)
+
+#: Blur resolution scale of the reference render in the blur estimate: small enough for 1x1 targets.
+MIN_BLUR_SCALE = 1e-6
+
 NOTES = " ".join(
     [
         "SwiftShader runs WebGPU on the CPU: absolute times describe this host's CPU, not a GPU, and the",
         "ratios between tiers follow texel counts more closely than they would on a GPU, where fixed",
-        "per-pass costs weigh more. Frame times include three's per-frame CPU work (uniform and bind",
-        "group updates, command encoding) and wait for GPU completion (onSubmittedWorkDone) once per",
-        "measured batch, not per frame. The blur cannot be switched off in the package (every debug view",
-        "is computed and the blur node runs before every render), so blur cost is measured by calling the",
-        "blur node's two passes alone (lab helper timeBlurPasses); render_minus_blur is the difference of",
-        "the render-only and blur-only medians, not a separate measurement. A tier changes the history",
-        "resolution and the blur resolution together (and, for refraction, only uniforms: the detail and",
-        "Fresnel strengths), so the update figures show the history scale and the blur figures the blur",
-        "scale. Report texels are the threads the scheduler accounts for: W·H per full-field dispatch",
+        "per-pass costs weigh more. Times include three's per-frame CPU work (uniform and bind group",
+        "updates, command encoding). Update-only batches (timeFrames) run back to back in one task and",
+        "await GPU completion once per batch, so CPU and GPU work of successive frames may overlap.",
+        "Frames that render are timed one per animation frame (lab timeAnimationFrames), each from its",
+        "update to its GPU completion: three advances its node frame once per animation-frame tick and the",
+        "scene pass and the blur run once per node frame, so renders back to back in one task would",
+        "repeat only the composite. The blur",
+        "cannot be switched off in the package (every debug view is computed and the blur node runs before",
+        "every render), and calling its passes outside a render re-runs the scene pass (a new node frame),",
+        "so blur_estimate is render_only minus render_only_blur_1x1 (the same render with the blur node's",
+        "resolution scale shrunk until both its targets are 1x1, lab helper setBlurScale): the blur's",
+        "resolution-dependent cost, per round; the fixed cost of its two passes stays in both terms. A tier",
+        "changes the history resolution and the blur resolution together (and, for refraction, only",
+        "uniforms: the detail and Fresnel strengths), so the update figures follow the history scale and the",
+        "blur estimate the blur scale; the scene pass and the composite run at the canvas size in every",
+        "tier. Report texels are the threads the scheduler accounts for: W·H per full-field dispatch",
         "(its 8×8 workgroups launch threads_launched, the extent guard drops the rest) and tiles × tile",
         "area per tile dispatch (edge tiles counted whole). Memory 'allocated' is the size of the history",
         "textures the effect created (three StorageTexture objects backing the GPU textures), times the",
@@ -118,8 +135,10 @@ def dab_segments(centre: tuple[float, float]) -> list[Segment]:
     ]
 
 
-def stroke_instants(frames: int, fps: int) -> list[float]:
-    return [k / fps for k in range(frames + 1)]
+def stroke_instants(segments: Sequence[Segment], frames: int, fps: int) -> list[float]:
+    """Frame instants from the stroke's first sample on, so every frame has work."""
+    start = segments[0].t0
+    return [start + k / fps for k in range(frames + 1)]
 
 
 def build_packages(
@@ -153,7 +172,7 @@ def build_packages(
 
 
 class Bench:
-    """One lab page: FrostLab plus the bench calls (timeFrames, timeBlurPasses, counters)."""
+    """One lab page: FrostLab plus the bench calls (timeFrames, setBlurScale, counters)."""
 
     def __init__(self, page: LabPage) -> None:
         if page.lab.get("error"):
@@ -173,10 +192,16 @@ class Bench:
         self.lab.reset()
         self.lab.queue(segments)
 
-    def time_frames(self, instants: list[float], draw: bool) -> dict[str, float]:
-        """Wall ms of the frames, and the dispatches/texels the effect counted while they ran."""
+    def time_frames(self, instants: list[float], draw: bool, paced: bool = False) -> dict[str, float]:
+        """Ms of the frames, and the dispatches/texels the effect counted while they ran.
+
+        ``paced``: one frame per animation frame, each to GPU completion (``timeAnimationFrames``), so the
+        once-per-frame nodes (scene pass, blur) run in every frame; otherwise back to back in one task,
+        GPU completion awaited once (``timeFrames``): right for update-only frames, not for renders."""
+        self.page.page.bring_to_front()  # a background tab may be throttled
         before = self.effect_counters()
-        ms = float(self.lab.call("([i, d]) => window.__lab.timeFrames(i, { draw: d })", [instants, draw]))
+        method = "timeAnimationFrames" if paced else "timeFrames"
+        ms = float(self.lab.call(f"([i, d]) => window.__lab.{method}(i, {{ draw: d }})", [instants, draw]))
         after = self.effect_counters()
         return {
             "ms": ms,
@@ -184,8 +209,8 @@ class Bench:
             "texels": after["texelsDispatched"] - before["texelsDispatched"],
         }
 
-    def time_blur(self, frames: int) -> dict[str, Any]:
-        blur: dict[str, Any] = self.lab.call("(n) => window.__lab.timeBlurPasses(n)", frames)
+    def set_blur_scale(self, scale: float) -> dict[str, Any]:
+        blur: dict[str, Any] = self.lab.call("(s) => window.__lab.setBlurScale(s)", scale)
         return blur
 
     def set_tier(self, name: str) -> list[int]:
@@ -236,9 +261,9 @@ def threads_launched(policy: str, history: Sequence[int], plan: dict[str, Any], 
     """Threads one update dispatch launches for ``texels`` scheduler texels (workgroup rounding)."""
     params = plan["params"]
     if policy == "full-field":
-        wx, wy = params["workgroup2d"]
+        wx, wy = (int(n) for n in params["workgroup2d"])
         return math.ceil(history[0] / wx) * wx * math.ceil(history[1] / wy) * wy
-    wl = params["workgroupLinear"]
+    wl = int(params["workgroupLinear"])
     return math.ceil(texels / wl) * wl
 
 
@@ -250,18 +275,27 @@ def measure_tiers(
 ) -> dict[str, Any]:
     plan = bench.plan()
     stroke = conformance_segments()
-    instants = stroke_instants(frames, fps)
+    instants = stroke_instants(stroke, frames, fps)
     still = [instants[-1]] * (frames + 1)  # update() answers 'none': render-only frames
 
     def one(tier: str) -> dict[str, Any]:
-        bench.set_tier(tier)
+        bench.set_tier(tier)  # also puts the tier's blur scale back
         bench.start(stroke)
         update = bench.time_frames(instants, draw=False)
         bench.start(stroke)
-        frame = bench.time_frames(instants, draw=True)
-        render = bench.time_frames(still, draw=True)
-        blur = bench.time_blur(frames)
-        return {"update": update, "frame": frame, "render": render, "blur": blur}
+        frame = bench.time_frames(instants, draw=True, paced=True)
+        render = bench.time_frames(still, draw=True, paced=True)
+        tiny = bench.set_blur_scale(MIN_BLUR_SCALE)
+        render_tiny = bench.time_frames(still, draw=True, paced=True)
+        restored = bench.set_blur_scale(plan["tiers"][tier]["blurScale"])
+        return {
+            "update": update,
+            "frame": frame,
+            "render": render,
+            "render_tiny_blur": render_tiny,
+            "blur": {"ms": render["ms"] - render_tiny["ms"]},
+            "blur_sizes": {"tier": restored["size"], "tiny": tiny["size"]},
+        }
 
     rounds: list[dict[str, dict[str, Any]]] = []
     for r in range(1 + repeats):
@@ -269,6 +303,7 @@ def measure_tiers(
         log(f"  tiers round {r}{' (warm-up)' if r == 0 else ''}: {' '.join(order)}")
         rounds.append({tier: one(tier) for tier in order})
     timed = rounds[1:]
+    metrics = ("update", "frame", "render", "render_tiny_blur", "blur")
 
     results: dict[str, Any] = {}
     for tier in TIERS:
@@ -276,22 +311,20 @@ def measure_tiers(
         bench.start(stroke)
         reports = bench.lab.advance(instants)
         totals = frame_totals(reports)
-        samples = {
-            k: [rd[tier][k]["ms"] / frames for rd in timed] for k in ("update", "frame", "render", "blur")
-        }
-        last = timed[-1][tier]
+        samples = {k: [rd[tier][k]["ms"] / frames for rd in timed] for k in metrics}
         scale = plan["tiers"][tier]
         results[tier] = {
             "history_scale": scale["historyScale"],
             "blur_scale": scale["blurScale"],
             "history_size": size,
-            "blur_target_size": last["blur"]["size"],
+            "blur_target_size": timed[-1][tier]["blur_sizes"]["tier"],
+            "blur_target_size_tiny": timed[-1][tier]["blur_sizes"]["tiny"],
             "ms_per_frame": {
                 "update_only": _summary(samples["update"]),
                 "update_and_render": _summary(samples["frame"]),
                 "render_only": _summary(samples["render"]),
-                "blur_passes_only": _summary(samples["blur"]),
-                "render_minus_blur": _median(samples["render"]) - _median(samples["blur"]),
+                "render_only_blur_1x1": _summary(samples["render_tiny_blur"]),
+                "blur_estimate": _summary(samples["blur"]),
             },
             "dense_stroke_reports": {**totals, "substeps": sorted({r["substeps"] for r in reports})},
             "timed_counts_match_reports": all(
@@ -300,7 +333,7 @@ def measure_tiers(
                 for rd in timed
                 for k in ("update", "frame")
             )
-            and all(rd[tier]["render"]["dispatches"] == 0 for rd in timed),
+            and all(rd[tier][k]["dispatches"] == 0 for rd in timed for k in ("render", "render_tiny_blur")),
             "memory": memory_record(bench, canvas, scale["historyScale"]),
         }
 
@@ -316,22 +349,27 @@ def measure_tiers(
         "policy": plan["params"]["policy"],
         "diffusivity": plan["params"]["diffusivity"],
         "history_format": plan["tier"]["historyFormat"],
-        "stroke": "creaturegen.frost.path.conformance_segments()",
+        "stroke": "creaturegen.frost.path.conformance_segments(), frames from its first sample",
         "frames": frames,
         "fps": fps,
         "measured": {
-            "update_only": "timeFrames(stroke instants, draw=false): history update (+ diffusion substeps)",
-            "update_and_render": "timeFrames(stroke instants, draw=true): update + effect.render()",
-            "render_only": "timeFrames(constant instants, draw=true): update() returns 'none', render only",
-            "blur_passes_only": "lab timeBlurPasses: the blur node's vertical + horizontal passes alone",
-            "render_minus_blur": "derived: median render_only - median blur_passes_only",
+            "update_only": "timeFrames(stroke instants, draw=false): history update (+ diffusion substeps), "
+            "frames back to back, GPU completion awaited once per batch",
+            "update_and_render": "timeAnimationFrames(stroke instants, draw=true): update + effect.render(), "
+            "one frame per animation frame, each to GPU completion",
+            "render_only": "timeAnimationFrames(constant instants, draw=true): update() returns 'none'; "
+            "scene pass, blur at the tier's scale, composite",
+            "render_only_blur_1x1": "render_only with the blur node's resolution scale set to "
+            f"{MIN_BLUR_SCALE:g} (lab setBlurScale): both blur targets 1x1, everything else unchanged",
+            "blur_estimate": "derived per round: render_only - render_only_blur_1x1, i.e. the blur's "
+            "resolution-dependent cost; the fixed cost of its two (1x1) passes is not in it",
         },
         "results": results,
         "measured_ratios_relative_to_full": {
             "update_only": relative("update"),
             "update_and_render": relative("frame"),
             "render_only": relative("render"),
-            "blur_passes_only": relative("blur"),
+            "blur_estimate": relative("blur"),
         },
     }
 
@@ -345,7 +383,7 @@ def idle_case(bench: Bench, segments: list[Segment], frames: int, fps: int) -> d
     """Stroke, decay until every tile retired, then idle frames; everything counted from the reports."""
     plan = bench.plan()
     params = plan["params"]
-    instants = stroke_instants(frames, fps)
+    instants = stroke_instants(segments, frames, fps)
     last_touch = max(s.t1 for s in segments)
     decay = min(params["visible"]["decay"], params["tilt"]["decay"])
     predicted = last_touch + math.log(1.0 / params["tolerance"]) / decay
@@ -403,12 +441,12 @@ def measure_sparse(
     repeats: int,
     log: Callable[[str], None],
 ) -> dict[str, Any]:
-    instants = stroke_instants(frames, fps)
     plans = {p: b.plan() for p, b in benches.items()}
     tile = plans["dirty-tiles"]["params"]["tileSize"]
     scale = plans["dirty-tiles"]["params"]["historyScale"]
     history = scaled_size(canvas[0], canvas[1], scale)
     dab = dab_segments(dab_centre(history, tile))
+    instants = stroke_instants(dab, frames, fps)
 
     rounds: list[dict[str, dict[str, Any]]] = []
     for r in range(1 + repeats):
@@ -531,21 +569,24 @@ def device_record(bench: Bench) -> dict[str, Any]:
 def table(report: dict[str, Any]) -> str:
     tiers = report["tiers"]
     rel = tiers["measured_ratios_relative_to_full"]
+    canvas = "x".join(map(str, report["parameters"]["canvas"]))
     lines = [
-        f"tiers ({tiers['package']}, {tiers['policy']}, canvas {'x'.join(map(str, report['parameters']['canvas']))},"
-        f" ms/frame medians; ×: cost relative to full, per-round medians)",
+        f"tiers ({tiers['package']}, {tiers['policy']}, canvas {canvas}, ms/frame medians;"
+        " ×: cost relative to full, per-round medians)",
         f"{'tier':<10}{'history':>9}{'blur':>8}{'update':>8}{'×':>6}{'upd+rnd':>9}{'×':>6}"
-        f"{'render':>8}{'blur':>7}{'×':>6}{'rnd-blur':>9}{'hist B der/alloc':>20}",
+        f"{'render':>8}{'×':>6}{'blur1x1':>8}{'blur est':>9}{'×':>6}{'hist B der/alloc':>20}",
     ]
     for tier in TIERS:
         r = tiers["results"][tier]
         ms, mem = r["ms_per_frame"], r["memory"]
+        history, blur = ("x".join(map(str, r[k])) for k in ("history_size", "blur_target_size"))
         lines.append(
-            f"{tier:<10}{'x'.join(map(str, r['history_size'])):>9}{'x'.join(map(str, r['blur_target_size'])):>8}"
+            f"{tier:<10}{history:>9}{blur:>8}"
             f"{ms['update_only']['median']:>8.2f}{rel['update_only'][tier]:>6.2f}"
             f"{ms['update_and_render']['median']:>9.2f}{rel['update_and_render'][tier]:>6.2f}"
-            f"{ms['render_only']['median']:>8.2f}{ms['blur_passes_only']['median']:>7.2f}"
-            f"{rel['blur_passes_only'][tier]:>6.2f}{ms['render_minus_blur']:>9.2f}"
+            f"{ms['render_only']['median']:>8.2f}{rel['render_only'][tier]:>6.2f}"
+            f"{ms['render_only_blur_1x1']['median']:>8.2f}{ms['blur_estimate']['median']:>9.2f}"
+            f"{rel['blur_estimate'][tier]:>6.2f}"
             f"{mem['history_bytes_derived']:>10}/{mem['history_bytes_allocated']:<9}"
         )
     sparse = report["sparse"]
@@ -578,7 +619,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     parser.add_argument("--out", type=Path, default=REPO / "bench" / "results" / "frost.json")
     parser.add_argument("--canvas", type=parse_canvas, default=(320, 192), help="drawing buffer WxH")
     parser.add_argument("--repeats", type=int, default=3, help="timed rounds after one warm-up round")
-    parser.add_argument("--frames", type=int, default=60, help="frames per timed batch")
+    parser.add_argument("--frames", type=int, default=30, help="frames per timed batch")
     parser.add_argument("--fps", type=int, default=60, help="frame rate of the replayed strokes")
     args = parser.parse_args(argv)
     if args.repeats < 1 or args.frames < 1 or args.fps < 1:
@@ -609,7 +650,7 @@ def main(argv: Sequence[str] | None = None) -> int:
 
         with serve(WEB_LAB, mounts={"out": out_root}) as base_url:
             log("[2/4] tiers (frost-full, setTier)")
-            with launch_lab_page(url(base_url, "tiers")) as page:
+            with launch_lab_page(url(base_url, "tiers"), extra_args=BROWSER_FLAGS) as page:
                 bench = Bench(page)
                 env = environment(page)
                 device = device_record(bench)
@@ -626,7 +667,7 @@ def main(argv: Sequence[str] | None = None) -> int:
                 ]
                 errors["tiers"] = bench.gpu_errors()
             log("[4/4] sparse dab: full-field vs dirty-tiles (frost-budgeted)")
-            with launch_lab_page(url(base_url, "full-field")) as page_ff:
+            with launch_lab_page(url(base_url, "full-field"), extra_args=BROWSER_FLAGS) as page_ff:
                 page_dt = second_page(page_ff, url(base_url, "dirty-tiles"))
                 benches = {"full-field": Bench(page_ff), "dirty-tiles": Bench(page_dt)}
                 sparse = measure_sparse(benches, canvas, args.frames, args.fps, args.repeats, log)
