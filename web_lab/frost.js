@@ -19,7 +19,6 @@ for (const name of ['createBuffer', 'createTexture', 'createBindGroup', 'createC
   const original = GPUDevice.prototype[name];
   GPUDevice.prototype[name] = function counted(...args) {
     deviceCounts[name] += 1;
-    if (name === 'createRenderPipeline') (window.__pipelineLabels ??= []).push(args[0]?.label ?? '?');
     return original.apply(this, args);
   };
 }
@@ -61,13 +60,10 @@ async function main() {
   renderer.setSize(width, height, true);
   await renderer.init();
   if (renderer.backend.isWebGPUBackend !== true) throw new Error('frost lab: three fell back to WebGL2; WebGPU is required');
-  console.log('lab: renderer ready');
   const pkg = await import(`/out/${slug}/index.js`);
-  console.log('lab: package imported');
   const { scene, camera } = labScene();
   const effect = await pkg.createFrostEffect(renderer, scene, camera);
   const device = renderer.backend.device;
-  console.log('lab: effect created');
 
   let clock = 0;
   let playing = false;
@@ -78,16 +74,14 @@ async function main() {
   }
 
   // Render once and warm every pipeline (all views share one material: the view is a uniform).
-  if (params.get('warm') !== '0') render();
-  console.log('lab: first render submitted');
+  render();
   await device.queue.onSubmittedWorkDone();
-  console.log('lab: first render done');
   const revealCounts = { ...deviceCounts };
 
   // One capture target, reused: a fresh RenderTarget per capture would build fresh pipelines.
   let captureTarget = null;
   async function capturePixels(view = 'final') {
-    const previous = effect.debugView ?? 'final';
+    const previous = effect.debugView;
     effect.setDebugView(view);
     const size = new THREE.Vector2();
     renderer.getDrawingBufferSize(size);
@@ -147,7 +141,7 @@ async function main() {
       const h = await effect.readHistory();
       return { width: h.width, height: h.height, data: Array.from(h.data) };
     },
-    setDebugView(name) { effect.setDebugView(name); effect.debugView = name; },
+    setDebugView(name) { effect.setDebugView(name); },
     setControl(name, value) { effect.setControl(name, value); },
     setTier(name) { effect.setTier(name); return effect.historySize; },
     resize(w, h, dpr = 1) {
@@ -158,7 +152,6 @@ async function main() {
     },
     capturePixels,
     render,
-    renderPlain() { renderer.render(scene, camera); },
     async finish() { await device.queue.onSubmittedWorkDone(); return errors.length; },
     counters() {
       const after = {};

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import hashlib
 from pathlib import Path
+from typing import Any
 
 from ..emit.render import render_folder, to_json
 from ..emit.writer import PackageFile, header_text, write_package
@@ -11,7 +12,7 @@ from ..spec.frost import FrostEffectSpec
 from .plan import build_plan
 
 
-def build_report(plan: dict[str, object]) -> dict[str, object]:
+def build_report(plan: dict[str, Any]) -> dict[str, Any]:
     return {
         "//": header_text(str(plan["specSha256"])),
         "kind": "frost",
@@ -20,12 +21,12 @@ def build_report(plan: dict[str, object]) -> dict[str, object]:
         "compilerVersion": plan["version"],
         "specSha256": plan["specSha256"],
         "historyFormat": plan["tier"],
-        "structureSha256": plan["structure"]["sha256"],  # type: ignore[index]
+        "structureSha256": plan["structure"]["sha256"],
         "memory": plan["memory"],
         "params": plan["params"],
         "debugViews": plan["debugViews"],
         "structure": plan["structure"],
-        "mainScreenPeriod": plan["refraction"]["mainScreenPeriod"],  # type: ignore[index]
+        "mainScreenPeriod": plan["refraction"]["mainScreenPeriod"],
         "gates": plan["gates"],
     }
 

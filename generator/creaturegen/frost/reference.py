@@ -121,11 +121,11 @@ class FrostReference:
         if plan.retire:
             self.state[plan.mask(plan.retire, w, h)] = 0.0
             report.dispatches += 1
-            report.texels += plan.texels(plan.retire, w, h)
+            report.texels += plan.texels(plan.retire)
         if not plan.update:
             return
         mask = plan.mask(plan.update, w, h)
-        texels = plan.texels(plan.update, w, h)
+        texels = plan.texels(plan.update)
         for chunk_index, chunk in enumerate(chunk_steps(steps, self.params.max_steps)):
             self._law(chunk, mask, first=chunk_index == 0)
             report.dispatches += 1

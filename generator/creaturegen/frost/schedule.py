@@ -51,7 +51,7 @@ class TilePlan:
             mask[y0 : y0 + self.tile_height, x0 : x0 + self.tile_width] = True
         return mask
 
-    def texels(self, tiles: tuple[int, ...], width: int, height: int) -> int:
+    def texels(self, tiles: tuple[int, ...]) -> int:
         """Texels a dispatch over these tiles covers, extent guards included (what the GPU is asked for)."""
         return len(tiles) * self.tile_width * self.tile_height
 

@@ -20,7 +20,7 @@ the params the package was built with (build-report.json). Gates:
 
 from __future__ import annotations
 
-import itertools
+import dataclasses
 import json
 from collections.abc import Iterator
 from contextlib import contextmanager
@@ -31,10 +31,10 @@ from typing import Any
 import numpy as np
 import numpy.typing as npt
 
-from ..frost.formats import HALF_FLOAT_TOLERANCE
+from ..frost.formats import HALF_FLOAT_TOLERANCE, replay
 from ..frost.params import FrostParams, params_from_plan
 from ..frost.path import FRAME_RATES, STROKE_SECONDS, STROKE_START, conformance_segments, frame_instants
-from ..frost.reference import STORAGE_OF_FORMAT, FrostReference, Storage, remap_bilinear
+from ..frost.reference import STORAGE_OF_FORMAT, Storage, remap_bilinear
 from .browser import launch_lab_page
 from .frost_session import FrostLab
 from .png import write_png
@@ -84,12 +84,7 @@ class ParityReport:
 
 
 def reference_replay(params: FrostParams, size: tuple[int, int], fps: int, storage: Storage) -> Array:
-    reference = FrostReference(params, size[0], size[1], storage)
-    for segment in conformance_segments():
-        reference.queue(segment)
-    for previous, current in itertools.pairwise(frame_instants(fps)):
-        reference.update(previous, current)
-    return reference.state
+    return replay(params, fps, storage, size).state
 
 
 def srgb_encode(linear: Array) -> Array:
@@ -145,7 +140,7 @@ def _history_gates(lab: FrostLab, params: FrostParams, report: ParityReport) -> 
     report.gate(
         f"GPU {slow} vs {fast} FPS history", gpu_rates, numpy_rates + HALF_FLOAT_TOLERANCE, "history units"
     )
-    law = FrostParams(**{**params.__dict__, "diffusivity": 0.0})
+    law = dataclasses.replace(params, diffusivity=0.0)
     law_rates = float(
         np.abs(
             reference_replay(law, size, slow, "float64") - reference_replay(law, size, fast, "float64")
@@ -222,7 +217,7 @@ def _mirror_gate(lab: FrostLab, package: Path, report: ParityReport, canvas: tup
     period = canvas[0] / 2
     lab.call("(p) => window.__lab.setControl('mainScreenPeriod', p)", period)
     shot = lab.capture("structure").astype(np.float64)
-    lab.call("(p) => window.__lab.setControl('mainScreenPeriod', p)", plan_period(package))
+    lab.call("(p) => window.__lab.setControl('mainScreenPeriod', p)", float(plan["mainScreenPeriod"]))
     width, height = canvas
     s = np.asarray((np.arange(width) + 0.5) / period, dtype=np.float64)
     t = np.asarray((np.arange(height) + 0.5) / period, dtype=np.float64)
@@ -246,11 +241,6 @@ def _mirror_gate(lab: FrostLab, package: Path, report: ParityReport, canvas: tup
         "8-bit codes",
         passed=repeat_error > PIXEL_CODES,
     )
-
-
-def plan_period(package: Path) -> float:
-    plan = json.loads((package / "build-report.json").read_text())
-    return float(plan.get("mainScreenPeriod", 480.0))
 
 
 def _views_gate(lab: FrostLab, package: Path, report: ParityReport) -> None:

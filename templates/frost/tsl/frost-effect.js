@@ -348,9 +348,14 @@ export async function createFrostEffect(renderer, scene, camera, options = {}) {
       refractDetail: vec3(offDetail.mul(0.5 / Math.max(r.detailStrength, 1e-6)).add(0.5), 0.5),
       finalNoRefraction: plainLook.final,
     };
-    let result = views.final;
+    // Branch on the view uniform (uniform control flow): a frame pays for the final image plus the one
+    // view shown, not for all of them, and switching views never rebuilds the material.
+    const result = views.final.toVar();
+    let chain = null;
     DEBUG_VIEWS.forEach((name, index) => {
-      result = select(uDebugView.equal(index), views[name], result);
+      if (name === 'final') return;
+      const assign = () => { result.assign(views[name]); };
+      chain = chain === null ? If(uDebugView.equal(index), assign) : chain.ElseIf(uDebugView.equal(index), assign);
     });
     return vec4(result, 1);
   });
@@ -415,12 +420,19 @@ export async function createFrostEffect(renderer, scene, camera, options = {}) {
   }
 
   function writeSteps(chunk) {
-    stepData.fill(0);
-    chunk.forEach((step, i) => {
-      const g = step.segment;
-      if (g) stepData.set([g.start[0], g.start[1], g.end[0], g.end[1]], i * 8);
-      stepData.set([step.dt, g ? 0.5 * (g.pressure0 + g.pressure1) : 0, g ? 1 : 0, 0], i * 8 + 4);
-    });
+    // Element writes, no temporary arrays: this runs every frame.
+    for (let i = 0; i < chunk.length; i++) {
+      const g = chunk[i].segment;
+      const o = i * 8;
+      stepData[o] = g ? g.start[0] : 0;
+      stepData[o + 1] = g ? g.start[1] : 0;
+      stepData[o + 2] = g ? g.end[0] : 0;
+      stepData[o + 3] = g ? g.end[1] : 0;
+      stepData[o + 4] = chunk[i].dt;
+      stepData[o + 5] = g ? 0.5 * (g.pressure0 + g.pressure1) : 0;
+      stepData[o + 6] = g ? 1 : 0;
+      stepData[o + 7] = 0;
+    }
     stepBuffer.value.addUpdateRange(0, chunk.length * 8);
     stepBuffer.value.needsUpdate = true;
     uStepCount.value = chunk.length;
@@ -574,6 +586,7 @@ export async function createFrostEffect(renderer, scene, camera, options = {}) {
     if (index < 0) throw new Error(`frost.setDebugView: unknown view ${JSON.stringify(name)} (known: ${DEBUG_VIEWS.join(', ')})`);
     uDebugView.value = index;
   }
+  const debugView = () => DEBUG_VIEWS[uDebugView.value];
 
   // Diagnostics only (the lab and tests): copies the latest history into a buffer and reads it back.
   let readbackBuffer = null;
@@ -605,6 +618,7 @@ export async function createFrostEffect(renderer, scene, camera, options = {}) {
     get tier() { return tierName; },
     get historySize() { return [histW, histH]; },
     get format() { return format; },
+    get debugView() { return debugView(); },
     get counters() { return counters; },
     pointer,
     update,
@@ -623,7 +637,6 @@ export async function createFrostEffect(renderer, scene, camera, options = {}) {
         structureBytes: structureBytes.byteLength + normalBytes.byteLength,
       };
     },
-    scheduler: () => scheduler,
     pipeline,
     dispose() {
       textures.forEach((t) => t.dispose());
