@@ -1,0 +1,71 @@
+"""float64 body distance and analytic gradient at points: the reference every surface stage measures with.
+
+Thin wrappers over field/sampler.py so surface code never forms colours it does not need, and chunked so
+a 10⁵-vertex mesh does not allocate (slots × points × 3) temporaries at once.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import numpy.typing as npt
+
+from ..field.primitives import primitive_distance, primitive_field
+from ..field.sampler import evaluate_distance, evaluate_graph
+from ..rig.graph import BlendGraph
+
+F64 = npt.NDArray[np.float64]
+CHUNK = 32768
+
+
+@dataclass(frozen=True)
+class BodyField:
+    """The rest (or any posed) slot table with its program: callable distance and gradient."""
+
+    graph: BlendGraph
+    slots: F64
+
+    def distance(self, points: npt.ArrayLike) -> F64:
+        p = np.asarray(points, dtype=np.float64).reshape(-1, 3)
+        out = np.empty(p.shape[0])
+        for s in range(0, p.shape[0], CHUNK):
+            out[s : s + CHUNK] = evaluate_distance(
+                self.graph, primitive_distance(self.slots, p[s : s + CHUNK])
+            )
+        return out
+
+    def field(self, points: npt.ArrayLike) -> tuple[F64, F64]:
+        """Distance (P,) and unnormalised analytic gradient (P, 3)."""
+        p = np.asarray(points, dtype=np.float64).reshape(-1, 3)
+        d = np.empty(p.shape[0])
+        g = np.empty((p.shape[0], 3))
+        for s in range(0, p.shape[0], CHUNK):
+            ds, gs = primitive_field(self.slots, p[s : s + CHUNK])
+            d[s : s + CHUNK], g[s : s + CHUNK] = evaluate_graph(self.graph, ds, gs)
+        return d, g
+
+    def gradient(self, points: npt.ArrayLike) -> F64:
+        return self.field(points)[1]
+
+    def slot_distances(self, points: npt.ArrayLike) -> F64:
+        """(S, P) every slot's own distance: who dominates where (weights, ownership)."""
+        result: F64 = primitive_distance(
+            self.slots, np.asarray(points, dtype=np.float64).reshape(-1, 3)
+        ).astype(np.float64, copy=False)
+        return result
+
+
+def project(field: BodyField, points: F64, steps: int = 3) -> tuple[F64, F64, F64]:
+    """Newton steps ``p ← p − d∇d/|∇d|²`` onto the zero set; returns points, their d and ∇d.
+
+    Points whose gradient vanishes (|∇d|² ≤ 1e-20) are left where they are; callers gate on |d|.
+    """
+    p = points.copy()
+    d, g = field.field(p)
+    for _ in range(steps):
+        gg = np.einsum("ij,ij->i", g, g)
+        ok = gg > 1e-20
+        p[ok] -= (d[ok] / gg[ok])[:, None] * g[ok]
+        d, g = field.field(p)
+    return p, d, g

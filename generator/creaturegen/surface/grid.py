@@ -1,0 +1,117 @@
+"""The sampling lattice of one body: resolution from a surface-error target, bounds from the slots.
+
+Spacing rule. A marching-cubes surface whose vertices lie on the zero set deviates from it inside a
+triangle by at most the chord sagitta ``h²κ/8`` for edge length ``h`` and curvature ``κ``. The sharpest
+convex curvature a body of round primitives has is ``1/r_min`` (its thinnest primitive end), so a target
+sagitta of ``ε·r_min`` gives ``h = √(8ε)·r_min``. Concave blend fillets are flatter than that (their
+radius grows with the blend width k), so the same bound covers them. The grid extent is capped: a body
+whose thinnest part would need more cells than ``MAX_CELLS_PER_AXIS`` fails the build naming that part
+rather than silently missing its error target.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+import numpy.typing as npt
+
+from ..field import layout as col
+from ..field.primitives import TAPER_EXACT_THRESHOLD
+from ..rig.graph import BlendGraph
+
+#: Surface-error target per tier, as a fraction of the smallest primitive radius (sagitta bound).
+ERROR_TARGET = {"hero": 0.02, "repeated": 0.06, "distant": 0.125}
+#: Largest lattice extent along any axis; beyond it the target is unreachable at load-time cost.
+MAX_CELLS_PER_AXIS = 640
+#: Fine cells per narrow-band block edge.
+BLOCK = 8
+#: Upper bound on |∇d| for every primitive form and blend (see ``lipschitz_bound``) with margin.
+LIPSCHITZ_MARGIN = 1.01
+
+
+class GridTooFineError(ValueError):
+    """The error target needs a lattice larger than MAX_CELLS_PER_AXIS; names the limiting slot."""
+
+
+@dataclass(frozen=True)
+class Grid:
+    """An axis-aligned lattice: node (i, j, k) sits at ``origin + spacing·(i, j, k)``."""
+
+    origin: tuple[float, float, float]
+    spacing: float
+    shape: tuple[int, int, int]  # nodes per axis, each a multiple of BLOCK plus one
+
+    def points(self, index: npt.NDArray[np.int64] | npt.NDArray[np.float64]) -> npt.NDArray[np.float64]:
+        """World positions of integer (or half-integer) lattice coordinates (N, 3)."""
+        result: npt.NDArray[np.float64] = np.asarray(self.origin) + self.spacing * index
+        return result
+
+    @property
+    def blocks(self) -> tuple[int, int, int]:
+        n = self.shape
+        return ((n[0] - 1) // BLOCK, (n[1] - 1) // BLOCK, (n[2] - 1) // BLOCK)
+
+
+def smallest_radius(slots: npt.NDArray[np.float64]) -> tuple[float, int]:
+    """The thinnest primitive end and its slot index: the curvature bound of the body."""
+    radii = np.minimum(slots[:, col.RA], slots[:, col.RB])
+    index = int(np.argmin(radii))
+    return float(radii[index]), index
+
+
+def spacing_for(slots: npt.NDArray[np.float64], tier: str) -> float:
+    """Lattice spacing meeting the tier's sagitta target relative to the thinnest primitive."""
+    r_min, _ = smallest_radius(slots)
+    return math.sqrt(8.0 * ERROR_TARGET[tier]) * r_min
+
+
+def lipschitz_bound(slots: npt.NDArray[np.float64]) -> float:
+    """A bound on |∇d| over the body: √(1+s²) for tapered capsules, 1 for exact forms, kept by blends.
+
+    Polynomial smooth-min and log-sum-exp gradients are convex combinations of their children's, and a
+    hard min picks one, so no blend raises the bound.
+    """
+    return LIPSCHITZ_MARGIN * math.sqrt(1.0 + TAPER_EXACT_THRESHOLD**2)
+
+
+def swell_bound(graph: BlendGraph) -> float:
+    """How far the blends can push the zero set beyond the primitives, summed over every op.
+
+    A polynomial smooth-min lies at most k/4 below the min of its children and an n-ary log-sum-exp at
+    most k·log N; nesting adds them, so the sum over all ops bounds any chain.
+    """
+    return sum(op.k / 4.0 if op.kernel == "poly" else op.k * math.log(len(op.children)) for op in graph.ops)
+
+
+def body_box(
+    slots: npt.NDArray[np.float64], graph: BlendGraph
+) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.float64]]:
+    """Rest AABB of every slot's end spheres, widened by the blends' swell bound."""
+    a, b = slots[:, col.A], slots[:, col.B]
+    r = np.maximum(slots[:, col.RA], slots[:, col.RB])[:, None]
+    swell = swell_bound(graph)
+    lo = np.minimum(a - r, b - r).min(axis=0) - swell
+    hi = np.maximum(a + r, b + r).max(axis=0) + swell
+    return lo, hi
+
+
+def make_grid(
+    slots: npt.NDArray[np.float64], graph: BlendGraph, tier: str, slot_names: tuple[str, ...]
+) -> Grid:
+    """The tier's lattice over the body box, padded by two cells and rounded up to whole blocks."""
+    h = spacing_for(slots, tier)
+    lo, hi = body_box(slots, graph)
+    lo = lo - 2.0 * h
+    cells = np.ceil((hi + 2.0 * h - lo) / h).astype(np.int64)
+    cells = ((cells + BLOCK - 1) // BLOCK) * BLOCK
+    if int(cells.max()) > MAX_CELLS_PER_AXIS:
+        r_min, index = smallest_radius(slots)
+        raise GridTooFineError(
+            f"part.{slot_names[index]}.r: radius {r_min:.4g} m needs {int(cells.max())} lattice cells "
+            f"along one axis for the {tier} surface-error target ({ERROR_TARGET[tier]}·r); the limit is "
+            f"{MAX_CELLS_PER_AXIS}. Thicken the part or choose a coarser tier."
+        )
+    shape = (int(cells[0]) + 1, int(cells[1]) + 1, int(cells[2]) + 1)
+    return Grid((float(lo[0]), float(lo[1]), float(lo[2])), h, shape)
