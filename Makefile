@@ -34,7 +34,8 @@ help:
 	@echo "make test     ruff, ruff format --check, mypy, pytest (browser tests included)"
 	@echo "make schemas  export JSON Schemas into schemas/"
 	@echo "make lab      serve $(WEB_LAB)/ at http://$(LAB_HOST):$(LAB_PORT)/"
-	@echo "make bench    bench/results/field.json (candidates, analytic vs FD) and frost.json (tiers, tiles, idle)"
+	@echo "make bench    bench/results/field.json (candidates, analytic vs FD), frost.json (tiers, tiles, idle),"
+	@echo "              surface.json (narrow band vs dense, numpy vs wgpu, extraction, gates)"
 	@echo "make clean    remove build output and caches; distclean also removes .venv and node_modules"
 
 # --- setup ------------------------------------------------------------------------------------
@@ -88,6 +89,8 @@ bench: setup
 	$(VENV_PY) bench/field.py --out bench/results/field.json
 	@echo "==> frost benchmark (WebGPU on SwiftShader) into bench/results/frost.json"
 	$(VENV_PY) bench/frost.py --out bench/results/frost.json
+	@echo "==> surface benchmark (narrow band vs dense, numpy vs wgpu, extraction, gates) into bench/results/surface.json"
+	$(VENV_PY) bench/surface.py --out bench/results/surface.json
 
 # --- checks -----------------------------------------------------------------------------------
 

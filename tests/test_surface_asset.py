@@ -148,9 +148,9 @@ def test_glb_framing_alignment_and_json(tmp_path: Path) -> None:
     assert formats == {
         "POSITION": (5126, "VEC3"),
         "NORMAL": (5126, "VEC3"),
-        "_SLOTS": (UNSIGNED_SHORT, "VEC4"),
+        "_SLOTS": (5126, "VEC4"),
         "_WEIGHTS": (5126, "VEC4"),
-        "_CANDIDATE": (UNSIGNED_SHORT, "SCALAR"),
+        "_CANDIDATE": (5126, "SCALAR"),
         "_RADIAL": (5126, "VEC2"),
     }
     for name, i in attributes.items():
@@ -159,7 +159,7 @@ def test_glb_framing_alignment_and_json(tmp_path: Path) -> None:
         # Every vertex element starts on a 4-byte boundary (the 2-byte _CANDIDATE gets byteStride 4).
         assert view.get("byteStride", 4) % 4 == 0, name
         assert accessors[i]["count"] == 5
-    assert views[accessors[attributes["_CANDIDATE"]]["bufferView"]]["byteStride"] == 4
+    assert "byteStride" not in views[accessors[attributes["_CANDIDATE"]]["bufferView"]]
     assert views[accessors[primitive["indices"]]["bufferView"]]["target"] == ELEMENT_ARRAY_BUFFER
     assert "byteStride" not in views[accessors[primitive["indices"]]["bufferView"]]
 
@@ -286,9 +286,9 @@ def test_three_gltfloader_reads_the_asset(tmp_path: Path) -> None:
     expected: dict[str, tuple[npt.NDArray[Any], str]] = {
         "position": (asset.positions, "Float32Array"),
         "normal": (asset.normals, "Float32Array"),
-        "_slots": (asset.slots, "Uint16Array"),
+        "_slots": (asset.slots, "Float32Array"),
         "_weights": (asset.weights, "Float32Array"),
-        "_candidate": (asset.candidate, "Uint16Array"),
+        "_candidate": (asset.candidate, "Float32Array"),
         "_radial": (asset.radial, "Float32Array"),
     }
     for name, (values, array_type) in expected.items():
@@ -297,8 +297,8 @@ def test_three_gltfloader_reads_the_asset(tmp_path: Path) -> None:
         assert (seen["itemSize"], seen["count"], seen["arrayType"]) == (width, 6, array_type), name
         assert seen["normalized"] is False
         assert np.array_equal(np.asarray(seen["values"], dtype=values.dtype), values.reshape(-1)), name
-        # Only the 2-byte _CANDIDATE is padded to a 4-byte stride, which three reads as interleaved.
-        assert seen["interleaved"] is (name == "_candidate"), name
+        # Every attribute is tightly packed 4-byte data: none is interleaved.
+        assert seen["interleaved"] is False, name
 
     index = report["index"]
     assert isinstance(index, dict)

@@ -25,6 +25,11 @@ from .rig.report import describe_rig
 from .spec import CharacterSpec, FrostEffectSpec, SpecError, SpecValidationError, load_spec, validate_bytes
 from .spec.schema import stale_schemas, write_schemas
 from .spec.summary import summarize
+from .surface.asset import SurfaceCache
+from .surface.build import DEFAULT_TIER, SurfaceBuild, SurfaceRejectedError, build_surface
+from .surface.deform import DeformationError
+from .surface.emit import write_surface_package
+from .surface.grid import GridTooFineError
 
 EXIT_OK = 0
 EXIT_INVALID = 2
@@ -90,11 +95,8 @@ def _build(args: argparse.Namespace) -> int:
         return EXIT_INVALID
     print(f"{args.spec}: ok")
     print("\n".join(summarize(spec)))
-    if not isinstance(spec, FrostEffectSpec):
-        print(
-            f"note: the creature package emitter is not implemented yet; nothing was written to {args.out}/"
-        )
-        return EXIT_OK
+    if isinstance(spec, CharacterSpec):
+        return _build_creature(args, spec, data)
     print(
         "==> frost: quantisation gate (30/60/120 FPS replays per storage format), structure maps", flush=True
     )
@@ -112,6 +114,51 @@ def _build(args: argparse.Namespace) -> int:
         print(f"  gate {gate['name']}: {gate['value']:.3g} (threshold {gate['threshold']:.3g}) {verdict}")
     print(f"  history format {report['historyFormat']['historyFormat']}")
     print(f"wrote {folder}/")
+    return EXIT_OK
+
+
+def _surface(
+    name: str, spec: CharacterSpec, rig: CompiledRig, tier: str, backend: str
+) -> SurfaceBuild | None:
+    """The surface at ``tier``; every failure is printed naming the gate or part, None then."""
+    try:
+        return build_surface(spec, rig, tier=tier, backend=backend, cache=SurfaceCache())
+    except (SurfaceRejectedError, GridTooFineError, DeformationError) as exc:
+        print_errors(name, [SpecError(f"surface.{tier}", str(exc))])
+    except ValueError as exc:
+        print_errors(name, [SpecError("--backend", str(exc))])
+    return None
+
+
+def _print_gates(build: SurfaceBuild) -> None:
+    for gate in build.gates:
+        verdict = "pass" if gate.passed else "FAIL"
+        relation = "<=" if gate.direction == "max" else ">="
+        print(f"  gate {gate.name}: {gate.value:.4g} {gate.unit} ({relation} {gate.threshold:.4g}) {verdict}")
+
+
+def _build_creature(args: argparse.Namespace, spec: CharacterSpec, data: bytes) -> int:
+    try:
+        rig = compile_rig(spec)
+    except RigCompileError as exc:
+        print_errors(args.spec, exc.errors)
+        return EXIT_INVALID
+    print(
+        f"==> surface {args.tier}: narrow-band sampling, extraction, gates, skin weights, deformation sweeps"
+    )
+    build = _surface(args.spec, spec, rig, args.tier, args.backend)
+    if build is None:
+        return EXIT_INVALID
+    _print_gates(build)
+    counts = build.sidecar["counts"]
+    print(f"  mesh {counts}; " + ("cache hit" if build.cached else "extracted"))
+    try:
+        folder = write_surface_package(Path(args.out), spec.name, data, build)
+    except PackageWriteError as exc:
+        print(f"{args.spec}: cannot write the package: {exc}", file=sys.stderr)
+        return EXIT_INVALID
+    print(f"wrote {folder}/ (assets/surface.glb, assets/surface.json, build-report.json)")
+    print("note: the creature runtime (core/, tsl/, index.js) is not emitted yet (issue 5)")
     return EXIT_OK
 
 
@@ -177,6 +224,18 @@ def _inspect(args: argparse.Namespace) -> int:
         return EXIT_INVALID
     print(f"==> candidate programs for tiers {', '.join(tiers)}", file=sys.stderr)
     report["candidates"] = describe_candidates(spec, rig, tiers)
+    surface = None
+    if args.surface:
+        print(f"==> surface {args.surface}", file=sys.stderr)
+        surface = _surface(args.spec, spec, rig, args.surface, args.backend)
+        if surface is None:
+            return EXIT_INVALID
+        report["surface"] = {
+            "tier": surface.tier,
+            "signatures": surface.signatures,
+            "counts": surface.sidecar["counts"],
+            "gates": [g.as_dict() for g in surface.gates],
+        }
     if args.json:
         print(json.dumps(report, indent=2, sort_keys=True))
         return EXIT_OK
@@ -195,6 +254,9 @@ def _inspect(args: argparse.Namespace) -> int:
                 f"sweep {summary['sweep']['points']} points: "
                 + ", ".join(f"{g['name']} {g['value']:.3g}/{g['threshold']:.3g}" for g in summary["gates"])
             )
+    if surface is not None:
+        print(f"  surface {surface.tier}: {surface.sidecar['counts']}")
+        _print_gates(surface)
     return EXIT_OK
 
 
@@ -259,11 +321,29 @@ def build_parser() -> argparse.ArgumentParser:
     inspect.add_argument(
         "--tiers", default=",".join(TIERS), help="candidate tiers to build (default: hero,repeated,distant)"
     )
+    inspect.add_argument(
+        "--surface",
+        metavar="TIER",
+        choices=tuple(TIERS),
+        help="also build the reference surface and print its gates",
+    )
+    inspect.add_argument("--backend", default="auto", help="surface sampling backend: auto, numpy or wgpu")
     inspect.set_defaults(run=_inspect)
 
     build = commands.add_parser("build", help="validate a spec and build its package into out/<slug>/")
     build.add_argument("spec", metavar="SPEC")
     build.add_argument("-o", "--out", default="out", help="output folder (default: out)")
+    build.add_argument(
+        "--tier",
+        default=DEFAULT_TIER,
+        choices=tuple(TIERS),
+        help=f"creature surface tier (default {DEFAULT_TIER})",
+    )
+    build.add_argument(
+        "--backend",
+        default="auto",
+        help="surface sampling backend: auto (the faster, measured), numpy or wgpu",
+    )
     build.set_defaults(run=_build)
 
     parity = commands.add_parser(

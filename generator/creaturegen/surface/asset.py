@@ -9,11 +9,10 @@ Layout of one file: one scene, one node, one mesh, one triangle primitive. Attri
 the min/max the spec requires) and NORMAL, plus application-specific ones (glTF wants a leading
 underscore; three.js's GLTFLoader lower-cases unknown names, so ``_SLOTS`` arrives as ``_slots``):
 
-- ``_SLOTS`` UNSIGNED_SHORT VEC4: the slot index of each of the four influences;
+- ``_SLOTS`` FLOAT VEC4: the slot index of each of the four influences (whole numbers, exact in
+  float32 below 2²⁴);
 - ``_WEIGHTS`` FLOAT VEC4: their weights (non-negative, sum 1);
-- ``_CANDIDATE`` UNSIGNED_SHORT SCALAR: the candidate program index. glTF requires every vertex
-  attribute element to start on a 4-byte boundary, so this 2-byte attribute has ``byteStride`` 4
-  (two zero bytes after each value); three.js reads it as an InterleavedBufferAttribute;
+- ``_CANDIDATE`` FLOAT SCALAR: the candidate program index (a whole number);
 - ``_RADIAL`` FLOAT VEC2: (θ around, t along) the dominant slot's axis.
 
 Indices are UNSIGNED_SHORT when every index fits below 65535 (the value glTF reserves for primitive
@@ -22,10 +21,10 @@ that no primitive uses; the node's ``extras.restFramesAccessor`` names it. The c
 (signatures and such) go to both ``asset.extras`` and the node's ``extras``: three.js exposes the
 first as ``gltf.asset.extras`` and the second as the mesh's ``userData``.
 
-A reader's caveat: three.js r185's WebGPU backend widens non-normalised UNSIGNED_SHORT vertex data
-to uint32 with a fixed 4-byte stride (WebGPUAttributeUtils, "patch for UINT16"), which fits neither a
-VEC4 (``_slots``) nor a strided scalar (``_candidate``); a WebGPU consumer should copy those two into
-Uint32/Float32 BufferAttributes after loading instead of drawing them as loaded.
+Why the indices are FLOAT: three.js r185's WebGPU backend widens non-normalised UNSIGNED_SHORT vertex
+data to uint32 with a fixed 4-byte stride (WebGPUAttributeUtils, "patch for UINT16"), which fits
+neither a VEC4 nor a 2-byte scalar padded to glTF's 4-byte element alignment. Float attributes load
+and draw as they are; the shader rounds them to integers.
 
 Determinism: arrays are written little-endian in a fixed order, every buffer view starts on a 4-byte
 boundary, the JSON has sorted keys, no whitespace and no NaN, the JSON chunk is padded with spaces and
@@ -281,9 +280,9 @@ def glb_bytes(asset: SurfaceAsset, *, name: str) -> bytes:
     attributes = {
         "POSITION": b.add(asset.positions, FLOAT, "VEC3", target=ARRAY_BUFFER, minmax=True),
         "NORMAL": b.add(asset.normals, FLOAT, "VEC3", target=ARRAY_BUFFER),
-        "_SLOTS": b.add(asset.slots, UNSIGNED_SHORT, "VEC4", target=ARRAY_BUFFER),
+        "_SLOTS": b.add(asset.slots.astype(np.float32), FLOAT, "VEC4", target=ARRAY_BUFFER),
         "_WEIGHTS": b.add(asset.weights, FLOAT, "VEC4", target=ARRAY_BUFFER),
-        "_CANDIDATE": b.add(asset.candidate, UNSIGNED_SHORT, "SCALAR", target=ARRAY_BUFFER, stride=4),
+        "_CANDIDATE": b.add(asset.candidate.astype(np.float32), FLOAT, "SCALAR", target=ARRAY_BUFFER),
         "_RADIAL": b.add(asset.radial, FLOAT, "VEC2", target=ARRAY_BUFFER),
     }
     index_type = UNSIGNED_SHORT if asset.vertex_count <= MAX_UINT16_VERTICES else UNSIGNED_INT
@@ -419,9 +418,9 @@ def parse_glb(data: bytes) -> SurfaceAsset:
             positions=_read_accessor(document, binary, attributes["POSITION"], "VEC3"),
             normals=_read_accessor(document, binary, attributes["NORMAL"], "VEC3"),
             indices=indices.astype(np.uint32),
-            slots=_read_accessor(document, binary, attributes["_SLOTS"], "VEC4"),
+            slots=_read_accessor(document, binary, attributes["_SLOTS"], "VEC4").astype(np.uint16),
             weights=_read_accessor(document, binary, attributes["_WEIGHTS"], "VEC4"),
-            candidate=_read_accessor(document, binary, attributes["_CANDIDATE"], "SCALAR"),
+            candidate=_read_accessor(document, binary, attributes["_CANDIDATE"], "SCALAR").astype(np.uint16),
             radial=_read_accessor(document, binary, attributes["_RADIAL"], "VEC2"),
             rest_frames=_read_accessor(document, binary, rest_index, "MAT4").reshape(-1, 4, 4),
             extras=document["asset"].get("extras", node_extras),

@@ -6,13 +6,14 @@ a 10⁵-vertex mesh does not allocate (slots × points × 3) temporaries at once
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
 import numpy.typing as npt
 
 from ..field.primitives import primitive_distance, primitive_field
-from ..field.sampler import evaluate_distance, evaluate_graph
+from ..field.sampler import evaluate_distance, evaluate_graph, evaluate_ops
 from ..rig.graph import BlendGraph
 
 F64 = npt.NDArray[np.float64]
@@ -44,6 +45,26 @@ class BodyField:
             ds, gs = primitive_field(self.slots, p[s : s + CHUNK])
             d[s : s + CHUNK], g[s : s + CHUNK] = evaluate_graph(self.graph, ds, gs)
         return d, g
+
+    def root_distances(self, points: npt.ArrayLike) -> F64:
+        """(R, P) each blend root's distance: the body is their hard min, creased where two tie."""
+        p = np.asarray(points, dtype=np.float64).reshape(-1, 3)
+        d_slots = primitive_distance(self.slots, p)
+        values = evaluate_ops(self.graph, d_slots, np.zeros((*d_slots.shape, 3)))
+        rows = [d_slots[r.index] if r.kind == "slot" else values[r.index].distance for r in self.graph.roots]
+        return np.stack(rows).astype(np.float64, copy=False)
+
+    def smooth(self, band: float) -> Callable[[F64], npt.NDArray[np.bool_]]:
+        """A mask function: True where no two roots come within ``band`` of each other (off the crease)."""
+
+        def mask(points: F64) -> npt.NDArray[np.bool_]:
+            if len(self.graph.roots) < 2:
+                return np.ones(np.asarray(points).reshape(-1, 3).shape[0], dtype=bool)
+            two = np.sort(self.root_distances(points), axis=0)[:2]
+            result: npt.NDArray[np.bool_] = (two[1] - two[0]) > band
+            return result
+
+        return mask
 
     def gradient(self, points: npt.ArrayLike) -> F64:
         return self.field(points)[1]

@@ -1,0 +1,490 @@
+"""The surface stage end to end: sample, extract, validate, weight, choose deformation, correct, store.
+
+One call per (body, tier). Every step reports progress (these are the slow parts of a build) and every
+measured property becomes a SurfaceGate; ``SurfaceRejectedError`` names the first failed gate and the
+part it concerns, so a build never ships a surface that failed one. The result is cached on disk by the
+three signatures (surface/asset.py); a hit skips everything but reading the file.
+"""
+
+from __future__ import annotations
+
+import sys
+import time
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+import numpy.typing as npt
+
+from .. import __version__
+from ..candidates import TierRejectedError, build_candidates
+from ..field import layout as col
+from ..rig import CompiledRig
+from ..spec import CharacterSpec
+from . import deform, identity
+from .asset import CachedSurface, SurfaceAsset, SurfaceCache
+from .backends import (
+    BACKENDS,
+    BackendUnavailableError,
+    FieldBackend,
+    NumpyBackend,
+    make_backend,
+    time_backend,
+)
+from .components import ComponentPolicy, component_policy
+from .correct import CorrectionReport, correct, trust_radius
+from .extract import Extraction, extract
+from .field64 import BodyField
+from .gates import DISTANCE_TOL, SurfaceGate, mesh_gates
+from .grid import Grid, make_grid
+from .mesh import Mesh
+from .sampling import sample_band
+from .skeleton import Skeleton, build_skeleton
+from .weights import skin_weights
+
+F64 = npt.NDArray[np.float64]
+Progress = Callable[[str], None]
+
+#: The default surface tier: the one every example's candidate programs accept.
+DEFAULT_TIER = "hero"
+#: Our extracted and relaxed meshes keep their 1st-percentile minimum angle above this (degrees); raw
+#: marching cubes would sit near 1.5°, which is why the relaxation exists.
+MIN_ANGLE_P1_DEG = 15.0
+#: The skin alone must stay within this fraction of L of the posed field over the sweep; vertices that do
+#: not are the correction region.
+SKIN_ERROR_FACTOR = DISTANCE_TOL
+#: Mesh-normal maxima (degrees): a blend fillet narrower than a few lattice cells turns the true normal
+#: faster than a triangle can follow, so the worst vertex sits well above the bulk (the p99 gates of
+#: surface/gates.py stay at 5° and 10°). Shading uses the analytic normals stored per vertex, not these.
+VERTEX_NORMAL_MAX_DEG = 45.0
+FACE_NORMAL_MAX_DEG = 60.0
+#: Vertices within this many lattice cells of a hard-min crease between two blend roots are left out of
+#: the normal gates: the analytic normal itself jumps there, so no mesh normal can agree with it.
+CREASE_BAND_CELLS = 2.0
+#: Finer lattices tried (each √2 finer) when a mesh gate fails before the build gives up.
+MAX_REFINEMENTS = 2
+#: Calibration points for picking the faster sampling backend.
+CALIBRATION_POINTS = 32768
+#: Candidate index written for a vertex no candidate region covers (it is never corrected).
+NO_PROGRAM = 65535
+
+
+class SurfaceRejectedError(Exception):
+    """A gate failed; the message names the gate, its value, its threshold and the part."""
+
+
+def stderr_progress(message: str) -> None:
+    print(f"  surface: {message}", file=sys.stderr, flush=True)
+
+
+@dataclass(frozen=True)
+class SamplingReport:
+    backend: str
+    choice: str  # why this backend: measured calibration or the caller's request
+    coarse: int
+    fine: int
+    settled: int
+    dense: int
+    active_blocks: int
+    total_blocks: int
+    seconds: float
+
+    def as_dict(self) -> dict[str, object]:
+        return dict(self.__dict__)
+
+
+@dataclass(frozen=True)
+class SurfaceBuild:
+    tier: str
+    signatures: dict[str, str]
+    asset: SurfaceAsset
+    sidecar: dict[str, object]
+    gates: tuple[SurfaceGate, ...]
+    cached: bool
+    folder: Path | None = None
+    timings: dict[str, float] = field(default_factory=dict)
+
+    @property
+    def passed(self) -> bool:
+        return all(g.passed for g in self.gates)
+
+
+def choose_backend(rig: CompiledRig, requested: str, progress: Progress) -> tuple[FieldBackend, str]:
+    """The requested backend, or for "auto" the faster of numpy and wgpu measured on this machine."""
+    if requested != "auto":
+        if requested not in BACKENDS:
+            raise ValueError(f"--backend: unknown {requested!r}; choose auto, {', '.join(BACKENDS)}")
+        return make_backend(requested, rig.graph, rig.slots), "requested"
+    numpy_backend = NumpyBackend(rig.graph, rig.slots)
+    rng = np.random.default_rng(0)
+    lo = np.min(np.minimum(rig.slots[:, col.A], rig.slots[:, col.B]), axis=0)
+    hi = np.max(np.maximum(rig.slots[:, col.A], rig.slots[:, col.B]), axis=0)
+    points = rng.uniform(lo, hi, (CALIBRATION_POINTS, 3)).astype(np.float32)
+    t_numpy = time_backend(numpy_backend, points, repeats=2)
+    try:
+        gpu = make_backend("wgpu", rig.graph, rig.slots)
+        t_gpu = time_backend(gpu, points, repeats=2)
+    except BackendUnavailableError as exc:
+        progress(f"sampling backend numpy (wgpu unavailable: {exc})")
+        return numpy_backend, f"wgpu unavailable: {exc}"
+    chosen: FieldBackend = gpu if t_gpu < t_numpy else numpy_backend
+    why = f"{CALIBRATION_POINTS}-point calibration: numpy {t_numpy * 1e3:.1f} ms, wgpu {t_gpu * 1e3:.1f} ms"
+    progress(f"sampling backend {chosen.name} ({why})")
+    return chosen, why
+
+
+def candidate_index(
+    spec: CharacterSpec, rig: CompiledRig, tier: str, rest: F64
+) -> tuple[npt.NDArray[np.int64], str]:
+    """Per vertex, the first candidate region (in program order) whose box holds its rest position."""
+    try:
+        found = build_candidates(spec, rig, tier)
+    except TierRejectedError as exc:
+        return np.full(rest.shape[0], NO_PROGRAM, dtype=np.int64), str(exc)
+    index = np.full(rest.shape[0], NO_PROGRAM, dtype=np.int64)
+    for n, program in enumerate(found.programs):
+        inside = np.all((rest >= np.asarray(program.lo)) & (rest <= np.asarray(program.hi)), axis=1)
+        index[(index == NO_PROGRAM) & inside] = n
+    return index, ""
+
+
+#: A vertex is on a joint's seam when at least this much of its weight lies on each side of the joint.
+SEAM_WEIGHT = 0.01
+
+
+def _sweep_poses(
+    skeleton: Skeleton, slots: F64, choice: deform.DeformationChoice
+) -> list[tuple[int, deform.Pose]]:
+    """The extreme poses of every joint's sweep: both bend axes at the limit, and the full twist."""
+    poses = []
+    bend, twist = np.radians(choice.bend_max_deg), np.radians(choice.twist_max_deg)
+    for _, child in skeleton.joints:
+        for axis, b, t in ((0, bend, 0.0), (0, -bend, 0.0), (1, bend, 0.0), (1, -bend, 0.0), (0, 0.0, twist)):
+            poses.append((child, deform.pose_joint(skeleton, slots, child, axis, b, t)))
+    return poses
+
+
+def seam(skeleton: Skeleton, weights: tuple[npt.NDArray[np.int32], F64], child: int) -> npt.NDArray[np.bool_]:
+    """Vertices weighted on both sides of the joint above ``child``: the only ones a joint pose deforms.
+
+    Every other vertex moves rigidly with its side, so its distance to the posed field changes only where
+    a swept limb passes through another part: interpenetration the sweep provokes, which no local
+    correction can or should repair.
+    """
+    moved = deform.subtree(skeleton, child)
+    on_moved = np.where(moved[weights[0]], weights[1], 0.0).sum(axis=1)
+    result: npt.NDArray[np.bool_] = (on_moved > SEAM_WEIGHT) & (on_moved < 1.0 - SEAM_WEIGHT)
+    return result
+
+
+def correction_sweep(
+    rig: CompiledRig,
+    mesh: Mesh,
+    normals: F64,
+    weights: tuple[npt.NDArray[np.int32], F64],
+    skeleton: Skeleton,
+    choice: deform.DeformationChoice,
+    programs: npt.NDArray[np.int64],
+) -> tuple[npt.NDArray[np.bool_], CorrectionReport, float]:
+    """Region policy and correction over the sweep's extreme poses, measured on each joint's seam.
+
+    The region is every seam vertex whose skinned position misses the posed field by more than
+    SKIN_ERROR_FACTOR·L in some pose of its joint; each pose is then corrected over the region's seam
+    vertices and the worst report kept. Returns (region, worst report, worst skin-only seam error in m).
+    """
+    owner = weights[0][:, 0]
+    radius = np.maximum(rig.slots[owner, col.RA], rig.slots[owner, col.RB])
+    trust = trust_radius(mesh, normals, radius)
+    gate = SKIN_ERROR_FACTOR * rig.body_scale
+    region = np.zeros(mesh.vertex_count, dtype=bool)
+    posed = []
+    worst_skin = 0.0
+    for child, pose in _sweep_poses(skeleton, rig.slots, choice):
+        on_seam = seam(skeleton, weights, child)
+        if not on_seam.any():
+            continue
+        skinned = deform.skin(
+            mesh.vertices, normals, weights[0], weights[1], pose, choice.methods, skeleton, choice.centers
+        )
+        posed_field = BodyField(rig.graph, deform.posed_slots(rig.slots, pose))
+        error = np.zeros(mesh.vertex_count)
+        error[on_seam] = np.abs(posed_field.distance(skinned.positions[on_seam]))
+        worst_skin = max(worst_skin, float(error.max()))
+        region |= error > gate
+        posed.append((posed_field, skinned, on_seam))
+    region &= programs != NO_PROGRAM
+    worst: CorrectionReport | None = None
+    for posed_field, skinned, on_seam in posed:
+        _, report = correct(posed_field, mesh, skinned.positions, skinned.normals, region & on_seam, trust)
+        if worst is None or report.residual_after > worst.residual_after:
+            worst = report
+    if worst is None:
+        worst = CorrectionReport(0, 0, 0.0, 0.0, 0.0, 0, 0, 0, 0, 0, 0)
+    return region, worst, worst_skin
+
+
+def _fail_on(gates: list[SurfaceGate], where: str) -> None:
+    failed = [g for g in gates if not g.passed]
+    if failed:
+        g = failed[0]
+        more = f" (and {len(failed) - 1} more)" if len(failed) > 1 else ""
+        detail = f": {g.detail}" if g.detail else ""
+        raise SurfaceRejectedError(
+            f"{where}: gate {g.name} = {g.value:.4g} {g.unit}, threshold {g.threshold:.4g} ({g.direction}){detail}{more}"
+        )
+
+
+@dataclass(frozen=True)
+class ValidatedMesh:
+    """The extracted mesh at the first lattice whose mesh gates pass (or the finest tried)."""
+
+    extraction: Extraction
+    gates: list[SurfaceGate]
+    policy: ComponentPolicy
+    grid: Grid
+    refinement: int
+    sampling: SamplingReport
+    timings: dict[str, float]
+
+
+def validated_mesh(
+    rig: CompiledRig, skeleton: Skeleton, tier: str, chosen: FieldBackend, why: str, progress: Progress
+) -> ValidatedMesh:
+    """Sample, extract and gate; retry √2 finer (up to MAX_REFINEMENTS) while a mesh gate fails."""
+    timings: dict[str, float] = {"sampling": 0.0, "extraction": 0.0, "validation": 0.0}
+    rest_field = BodyField(rig.graph, rig.slots)
+    for refinement in range(MAX_REFINEMENTS + 1):
+        grid = make_grid(rig.slots, rig.graph, tier, rig.slot_parts, refinement)
+        progress(
+            f"lattice {grid.shape} at h = {grid.spacing:.4g} m ({tier}, refinement {refinement}); "
+            f"narrow-band sampling with {chosen.name}"
+        )
+        t = time.perf_counter()
+        band = sample_band(grid, chosen, rig.graph, rig.slots, rig.body_scale)
+        timings["sampling"] += time.perf_counter() - t
+        progress(
+            f"sampled {band.fine_samples:,} fine + {band.coarse_samples:,} coarse nodes "
+            f"({band.fine_samples / band.dense_samples:.1%} of a dense pass)"
+        )
+        t = time.perf_counter()
+        ex = extract(rest_field, band, rig.body_scale)
+        mesh = ex.mesh
+        timings["extraction"] += time.perf_counter() - t
+        progress(f"extracted {mesh.vertex_count:,} vertices, {mesh.face_count:,} triangles")
+        t = time.perf_counter()
+        policy = component_policy(mesh, rig.slots, rig.graph, skeleton.names)
+        gates = mesh_gates(
+            mesh,
+            length_scale=rig.body_scale,
+            distance=rest_field.distance,
+            gradient=rest_field.gradient,
+            expected_components=policy.expected,
+            min_angle_bound_deg=MIN_ANGLE_P1_DEG,
+            vertex_normal_max_deg=VERTEX_NORMAL_MAX_DEG,
+            face_normal_max_deg=FACE_NORMAL_MAX_DEG,
+            smooth=rest_field.smooth(CREASE_BAND_CELLS * grid.spacing),
+        )
+        gates += [
+            SurfaceGate(
+                "strayComponents",
+                float(len(policy.strays)),
+                0.0,
+                "components",
+                "max",
+                f"components {list(policy.strays)} own no slot" if policy.strays else "",
+            ),
+            SurfaceGate(
+                "unownedSlots",
+                float(len(policy.unowned_slots)),
+                0.0,
+                "slots",
+                "max",
+                ", ".join(policy.unowned_slots),
+            ),
+            SurfaceGate("unbracketedEdges", float(ex.unresolved_edges), 0.0, "vertices", "max"),
+        ]
+        timings["validation"] += time.perf_counter() - t
+        failed = [g.name for g in gates if not g.passed]
+        progress(
+            f"mesh gates: {len(gates) - len(failed)}/{len(gates)} passed"
+            + (f"; failed {failed}" if failed else "")
+        )
+        if not failed or refinement == MAX_REFINEMENTS:
+            break
+        progress("refining the lattice by √2 and extracting again")
+    sampling = SamplingReport(
+        chosen.name,
+        why,
+        band.coarse_samples,
+        band.fine_samples,
+        band.settled_samples,
+        band.dense_samples,
+        band.active_blocks,
+        band.total_blocks,
+        timings["sampling"],
+    )
+    return ValidatedMesh(ex, gates, policy, grid, refinement, sampling, timings)
+
+
+def build_surface(
+    spec: CharacterSpec,
+    rig: CompiledRig,
+    *,
+    tier: str = DEFAULT_TIER,
+    backend: str = "auto",
+    cache: SurfaceCache | None = None,
+    progress: Progress = stderr_progress,
+    strict: bool = True,
+) -> SurfaceBuild:
+    """The validated reference surface of one body at one tier (from the cache when it is there)."""
+    extra = {"creaturegen": __version__}
+    compiler = identity.compiler_signature(rig, tier, extra)
+    geometry = identity.signatures(rig).geometryDigest
+    settings = identity.settings_digest(tier, extra)
+    if cache is not None:
+        hit: CachedSurface | None = cache.lookup(compiler, geometry, tier, settings)
+        if hit is not None:
+            progress(f"cache hit {hit.folder}")
+            gates = tuple(SurfaceGate(**g) for g in _gate_rows(hit.sidecar))
+            return SurfaceBuild(
+                tier, dict(_sig_rows(hit.sidecar)), hit.asset, hit.sidecar, gates, True, hit.folder
+            )
+
+    t0 = time.perf_counter()
+    chosen, why = choose_backend(rig, backend, progress)
+    rest_field = BodyField(rig.graph, rig.slots)
+    skeleton = build_skeleton(spec, rig)
+    validated = validated_mesh(rig, skeleton, tier, chosen, why, progress)
+    ex, gates, policy, grid = validated.extraction, validated.gates, validated.policy, validated.grid
+    mesh, refinement, sampling, timings = ex.mesh, validated.refinement, validated.sampling, validated.timings
+    if policy.detached:
+        progress(f"declared: {', '.join(policy.detached)} detached from the body (the field leaves a gap)")
+    if strict:
+        _fail_on(gates, f"surface {tier}")
+
+    t = time.perf_counter()
+    weights = skin_weights(mesh, rest_field, skeleton)
+    gates += list(weights.gates)
+    timings["weights"] = time.perf_counter() - t
+    progress(f"skin weights: {weights.barrier_edges} barrier edges, {timings['weights']:.2f} s")
+    if strict:
+        _fail_on(list(weights.gates), f"surface {tier} skin weights")
+
+    t = time.perf_counter()
+    choice = deform.choose_deformation(
+        mesh, weights.indices, weights.weights, rest_field, skeleton, rig.slots, rig.graph, rig.body_scale
+    )
+    timings["deformation"] = time.perf_counter() - t
+    counts = {m: choice.methods.count(m) for m in deform.METHODS}
+    progress(f"deformation per joint: {counts} in {timings['deformation']:.2f} s")
+
+    t = time.perf_counter()
+    programs, candidate_note = candidate_index(spec, rig, tier, mesh.vertices)
+    region, report, worst_skin = correction_sweep(
+        rig, mesh, ex.normals, (weights.indices, weights.weights), skeleton, choice, programs
+    )
+    timings["correction"] = time.perf_counter() - t
+    correction_gates = [
+        SurfaceGate(
+            "correctionNeverWorse",
+            report.residual_after - report.residual_before,
+            0.0,
+            "m",
+            "max",
+            "the corrected residual may not exceed the skinned one",
+        ),
+        SurfaceGate(
+            "correctionUncovered",
+            float(np.count_nonzero((programs == NO_PROGRAM))),
+            0.0 if not candidate_note else float(mesh.vertex_count),
+            "vertices",
+            "max",
+            candidate_note,
+        ),
+    ]
+    gates += correction_gates
+    progress(
+        f"correction region {int(region.sum()):,} vertices (skin-only error {worst_skin / rig.body_scale:.2e} L); "
+        f"corrected residual {report.residual_corrected / rig.body_scale:.2e} L, {report.clamped} clamped, "
+        f"{report.backtracks} backtracks, {report.rejected_descent + report.rejected_inversion + report.rejected_gradient} rejected"
+    )
+    if strict:
+        _fail_on(correction_gates, f"surface {tier} correction")
+
+    from .frames import radial_coordinates, rest_frames
+
+    frames = rest_frames(rig, skeleton)
+    dominant = weights.indices[:, 0]
+    radial = np.zeros((mesh.vertex_count, 2))
+    for s in range(rig.slot_count):
+        rows = np.flatnonzero(dominant == s)
+        if rows.size:
+            length = float(np.linalg.norm(rig.slots[s, col.B] - rig.slots[s, col.A]))
+            theta, along = radial_coordinates(mesh.vertices[rows], frames[s], length)
+            radial[rows, 0], radial[rows, 1] = theta, along
+
+    sig = identity.surface_signatures(rig, tier, mesh.faces, choice.methods, extra)
+    signatures = {
+        "compilerSignature": sig.compilerSignature,
+        "topologySignature": sig.topologySignature,
+        "geometryDigest": sig.geometryDigest,
+    }
+    asset = SurfaceAsset(
+        positions=mesh.vertices.astype(np.float32),
+        normals=ex.normals.astype(np.float32),
+        indices=mesh.faces.reshape(-1).astype(np.uint32),
+        slots=weights.indices.astype(np.uint16),
+        weights=weights.weights.astype(np.float32),
+        candidate=programs.astype(np.uint16),
+        radial=radial.astype(np.float32),
+        rest_frames=np.transpose(frames, (0, 2, 1)).astype(np.float32),
+        extras={"creaturegen": __version__, "tier": tier, **signatures},
+    )
+    sidecar: dict[str, object] = {
+        "tier": tier,
+        "signatures": signatures,
+        "counts": {"vertices": mesh.vertex_count, "triangles": mesh.face_count, "slots": rig.slot_count},
+        "grid": {
+            "shape": list(grid.shape),
+            "spacing": grid.spacing,
+            "origin": list(grid.origin),
+            "refinement": refinement,
+        },
+        "sampling": sampling.as_dict(),
+        "extraction": {"residual": ex.residual, "relaxReverted": ex.relax_reverted},
+        "components": {
+            "count": policy.count,
+            "owners": list(policy.owners),
+            "splitRoots": list(policy.split_roots),
+            "detached": list(policy.detached),
+        },
+        "deformation": choice.describe(),
+        "correction": {
+            **report.as_dict(),
+            "region": int(region.sum()),
+            "skinOnlyError": worst_skin,
+            "candidateNote": candidate_note,
+        },
+        "gates": [g.as_dict() for g in gates],
+        "timings": timings,
+    }
+    folder = None
+    if cache is not None:
+        folder = cache.store(
+            sig.compilerSignature, sig.topologySignature, geometry, tier, settings, asset, sidecar
+        )
+    timings["total"] = time.perf_counter() - t0
+    return SurfaceBuild(tier, signatures, asset, sidecar, tuple(gates), False, folder, timings)
+
+
+def _gate_rows(sidecar: dict[str, object]) -> list[dict[str, object]]:
+    rows = sidecar.get("gates", [])
+    assert isinstance(rows, list)
+    return [{k: v for k, v in row.items() if k != "passed"} for row in rows]
+
+
+def _sig_rows(sidecar: dict[str, object]) -> dict[str, str]:
+    sig = sidecar.get("signatures", {})
+    assert isinstance(sig, dict)
+    return {str(k): str(v) for k, v in sig.items()}
