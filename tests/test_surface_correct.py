@@ -9,6 +9,7 @@ import numpy as np
 import pytest
 
 from conftest import EXAMPLES
+from creaturegen.field import layout as col
 from creaturegen.rig import compile_rig
 from creaturegen.spec import load_spec
 from creaturegen.surface.backends import NumpyBackend
@@ -17,7 +18,6 @@ from creaturegen.surface.extract import Extraction, extract
 from creaturegen.surface.field64 import BodyField
 from creaturegen.surface.grid import make_grid
 from creaturegen.surface.sampling import sample_band
-from creaturegen.field import layout as col
 
 
 @cache
@@ -33,7 +33,7 @@ def _surface(name: str) -> tuple[BodyField, Extraction, float, np.ndarray]:
 
 
 def test_correction_reduces_the_residual_within_the_trust_radius() -> None:
-    field, ex, length, radius = _surface("reference/biped.json")
+    field, ex, _, radius = _surface("reference/biped.json")
     trust = trust_radius(ex.mesh, ex.normals, radius)
     rng = np.random.default_rng(7)
     offset = rng.uniform(-0.3, 0.3, ex.mesh.vertex_count) * trust

@@ -22,10 +22,11 @@ from .field.sampler import sample
 from .frost.build import build_frost
 from .rig import CompiledRig, RigCompileError, compile_rig
 from .rig.report import describe_rig
-from .spec import CharacterSpec, FrostEffectSpec, SpecError, SpecValidationError, load_spec, validate_bytes
+from .spec import CharacterSpec, SpecError, SpecValidationError, load_spec, validate_bytes
 from .spec.schema import stale_schemas, write_schemas
 from .spec.summary import summarize
 from .surface.asset import SurfaceCache
+from .surface.backends import BACKENDS
 from .surface.build import DEFAULT_TIER, SurfaceBuild, SurfaceRejectedError, build_surface
 from .surface.deform import DeformationError
 from .surface.emit import write_surface_package
@@ -327,7 +328,9 @@ def build_parser() -> argparse.ArgumentParser:
         choices=tuple(TIERS),
         help="also build the reference surface and print its gates",
     )
-    inspect.add_argument("--backend", default="auto", help="surface sampling backend: auto, numpy or wgpu")
+    inspect.add_argument(
+        "--backend", default="auto", choices=("auto", *BACKENDS), help="surface sampling backend"
+    )
     inspect.set_defaults(run=_inspect)
 
     build = commands.add_parser("build", help="validate a spec and build its package into out/<slug>/")
@@ -342,6 +345,7 @@ def build_parser() -> argparse.ArgumentParser:
     build.add_argument(
         "--backend",
         default="auto",
+        choices=("auto", *BACKENDS),
         help="surface sampling backend: auto (the faster, measured), numpy or wgpu",
     )
     build.set_defaults(run=_build)

@@ -21,6 +21,7 @@ from .. import __version__
 from ..candidates import TierRejectedError, build_candidates
 from ..field import layout as col
 from ..rig import CompiledRig
+from ..rig.signatures import signatures as rig_signatures
 from ..spec import CharacterSpec
 from . import deform, identity
 from .asset import CachedSurface, SurfaceAsset, SurfaceCache
@@ -36,7 +37,7 @@ from .components import ComponentPolicy, component_policy
 from .correct import CorrectionReport, correct, trust_radius
 from .extract import Extraction, extract
 from .field64 import BodyField
-from .gates import DISTANCE_TOL, SurfaceGate, mesh_gates
+from .gates import DISTANCE_TOL, Direction, SurfaceGate, mesh_gates
 from .grid import Grid, make_grid
 from .mesh import Mesh
 from .sampling import sample_band
@@ -231,7 +232,8 @@ def _fail_on(gates: list[SurfaceGate], where: str) -> None:
         more = f" (and {len(failed) - 1} more)" if len(failed) > 1 else ""
         detail = f": {g.detail}" if g.detail else ""
         raise SurfaceRejectedError(
-            f"{where}: gate {g.name} = {g.value:.4g} {g.unit}, threshold {g.threshold:.4g} ({g.direction}){detail}{more}"
+            f"{where}: gate {g.name} = {g.value:.4g} {g.unit}, "
+            f"threshold {g.threshold:.4g} ({g.direction}){detail}{more}"
         )
 
 
@@ -338,17 +340,17 @@ def build_surface(
     strict: bool = True,
 ) -> SurfaceBuild:
     """The validated reference surface of one body at one tier (from the cache when it is there)."""
-    extra = {"creaturegen": __version__}
+    extra: dict[str, object] = {"creaturegen": __version__}
     compiler = identity.compiler_signature(rig, tier, extra)
-    geometry = identity.signatures(rig).geometryDigest
+    geometry = rig_signatures(rig).geometryDigest
     settings = identity.settings_digest(tier, extra)
     if cache is not None:
         hit: CachedSurface | None = cache.lookup(compiler, geometry, tier, settings)
         if hit is not None:
             progress(f"cache hit {hit.folder}")
-            gates = tuple(SurfaceGate(**g) for g in _gate_rows(hit.sidecar))
+            cached = tuple(_gate_from_row(g) for g in _gate_rows(hit.sidecar))
             return SurfaceBuild(
-                tier, dict(_sig_rows(hit.sidecar)), hit.asset, hit.sidecar, gates, True, hit.folder
+                tier, dict(_sig_rows(hit.sidecar)), hit.asset, hit.sidecar, cached, True, hit.folder
             )
 
     t0 = time.perf_counter()
@@ -376,6 +378,18 @@ def build_surface(
         mesh, weights.indices, weights.weights, rest_field, skeleton, rig.slots, rig.graph, rig.body_scale
     )
     timings["deformation"] = time.perf_counter() - t
+    for joint in choice.joints:
+        gates += [
+            SurfaceGate(
+                f"deform.{joint.joint}.{joint.method}.{g.name}",
+                g.value,
+                g.threshold,
+                g.unit,
+                g.direction,
+                g.detail,
+            )
+            for g in joint.gates
+        ]
     counts = {m: choice.methods.count(m) for m in deform.METHODS}
     progress(f"deformation per joint: {counts} in {timings['deformation']:.2f} s")
 
@@ -396,7 +410,7 @@ def build_surface(
         ),
         SurfaceGate(
             "correctionUncovered",
-            float(np.count_nonzero((programs == NO_PROGRAM))),
+            float(np.count_nonzero(programs == NO_PROGRAM)),
             0.0 if not candidate_note else float(mesh.vertex_count),
             "vertices",
             "max",
@@ -404,10 +418,12 @@ def build_surface(
         ),
     ]
     gates += correction_gates
+    rejected = report.rejected_descent + report.rejected_inversion + report.rejected_gradient
     progress(
-        f"correction region {int(region.sum()):,} vertices (skin-only error {worst_skin / rig.body_scale:.2e} L); "
+        f"correction region {int(region.sum()):,} vertices "
+        f"(skin-only seam error {worst_skin / rig.body_scale:.2e} L); "
         f"corrected residual {report.residual_corrected / rig.body_scale:.2e} L, {report.clamped} clamped, "
-        f"{report.backtracks} backtracks, {report.rejected_descent + report.rejected_inversion + report.rejected_gradient} rejected"
+        f"{report.backtracks} backtracks, {rejected} rejected"
     )
     if strict:
         _fail_on(correction_gates, f"surface {tier} correction")
@@ -482,6 +498,21 @@ def _gate_rows(sidecar: dict[str, object]) -> list[dict[str, object]]:
     rows = sidecar.get("gates", [])
     assert isinstance(rows, list)
     return [{k: v for k, v in row.items() if k != "passed"} for row in rows]
+
+
+def _gate_from_row(row: dict[str, object]) -> SurfaceGate:
+    direction: Direction = "min" if row.get("direction") == "min" else "max"
+    value, threshold = row["value"], row["threshold"]
+    assert isinstance(value, int | float)
+    assert isinstance(threshold, int | float)
+    return SurfaceGate(
+        str(row["name"]),
+        float(value),
+        float(threshold),
+        str(row["unit"]),
+        direction,
+        str(row.get("detail", "")),
+    )
 
 
 def _sig_rows(sidecar: dict[str, object]) -> dict[str, str]:

@@ -5,10 +5,12 @@ components than roots but never a component that owns no slot (a stray island: a
 bubble): those are rejected. A root whose slots land in two components is *declared*, not rejected: the
 field itself can leave a part detached (a rope anchored beyond its parent's surface has positive
 distance all the way between them), and the mesh must show the field, so the build reports each
-detached part by name and the gap instead of bridging it. Ownership is geometric, not by nearest vertex: a slot's axis midpoint lies inside its own
-primitive and so inside the body, and the component whose generalised winding number there is ≥ ½
-encloses it. The expected component count is therefore derived, not authored: the number of components
-that own a slot, which the policy requires to be every component.
+detached part by name instead of bridging it.
+
+Ownership is geometric, not by nearest vertex: a slot's axis midpoint lies inside its own primitive
+and so inside the body, and the component whose generalised winding number there is ≥ ½ encloses it.
+The expected component count is therefore derived, not authored: the number of components that own a
+slot, which the policy requires to be every component.
 """
 
 from __future__ import annotations
@@ -37,7 +39,7 @@ class ComponentPolicy:
 
     @property
     def expected(self) -> int:
-        return len(set(o for o in self.owners if o >= 0))
+        return len({o for o in self.owners if o >= 0})
 
     @property
     def passed(self) -> bool:
@@ -45,7 +47,7 @@ class ComponentPolicy:
 
 
 def winding_numbers(corners: F64, points: F64) -> F64:
-    """Generalised winding number of a closed triangle set at points (Van Oosterom–Strackee)."""
+    """Generalised winding number of a closed triangle set at points (Van Oosterom and Strackee)."""
     out = np.empty(points.shape[0])
     for i, p in enumerate(points):
         a, b, c = corners[:, 0] - p, corners[:, 1] - p, corners[:, 2] - p
@@ -80,7 +82,7 @@ def component_policy(mesh: Mesh, slots: F64, graph: BlendGraph, names: tuple[str
     for label in range(found.count):
         w = winding_numbers(corners[found.face_labels == label], midpoints)
         owners[(w >= 0.5) & (owners < 0)] = label
-    owned = set(int(o) for o in owners if o >= 0)
+    owned = {int(o) for o in owners if o >= 0}
     strays = tuple(label for label in range(found.count) if label not in owned)
     split = []
     detached = []

@@ -46,7 +46,7 @@ def surface_files(name: str, spec_bytes: bytes, build: SurfaceBuild) -> list[Pac
             "gates": [g.as_dict() for g in build.gates],
             "passed": build.passed,
         },
-        "emitter": "the creature runtime (core/, tsl/, index.js) is issue 5; this build writes the surface only",
+        "emitter": "surface only; the creature runtime (core/, tsl/, index.js) is not emitted yet",
     }
     return [
         PackageFile("assets/surface.glb", glb_bytes(build.asset, name=slugify(name))),

@@ -22,7 +22,9 @@ from ..rig import CompiledRig
 from ..rig.signatures import Signatures, compiler_description, signatures, topology_description
 from . import correct, extract, grid, sampling
 
-EXTRACTOR = "sign-lattice lewiner marching cubes (scikit-image), float64 Illinois edge roots, tangential relaxation"
+EXTRACTOR = (
+    "sign-lattice lewiner marching cubes (scikit-image), float64 Illinois edge roots, tangential relaxation"
+)
 
 
 def _sha(data: object) -> str:
@@ -55,7 +57,11 @@ def settings_digest(tier: str, extra: dict[str, object]) -> str:
 
 
 def surface_signatures(
-    rig: CompiledRig, tier: str, faces: npt.NDArray[np.int32], methods: tuple[str, ...], extra: dict[str, object]
+    rig: CompiledRig,
+    tier: str,
+    faces: npt.NDArray[np.int32],
+    methods: tuple[str, ...],
+    extra: dict[str, object],
 ) -> Signatures:
     base = signatures(rig)
     compiler = compiler_signature(rig, tier, extra)
@@ -69,7 +75,9 @@ def surface_signatures(
             "deformation": list(methods),
         }
     )
-    return Signatures(compilerSignature=compiler, topologySignature=topology, geometryDigest=base.geometryDigest)
+    return Signatures(
+        compilerSignature=compiler, topologySignature=topology, geometryDigest=base.geometryDigest
+    )
 
 
 def compiler_signature(rig: CompiledRig, tier: str, extra: dict[str, object]) -> str:

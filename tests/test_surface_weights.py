@@ -1,0 +1,218 @@
+"""Skin weights: every gate passes on real creatures, and the barrier gate fails when the barrier is off.
+
+The examples cover legs touching the shell (beetle), knees buried in the body and a rope tail
+(quadruped), a long tapering rope tail with legs (lizard) and wings (moth). The barrier counter-example
+is a small creature built here: two claws, siblings under one body, whose tips touch.
+"""
+
+from __future__ import annotations
+
+import json
+from dataclasses import dataclass
+from functools import cache
+from typing import Any
+
+import numpy as np
+import pytest
+
+from conftest import EXAMPLES
+from creaturegen.rig import compile_rig
+from creaturegen.spec import CharacterSpec, load_spec, validate_bytes
+from creaturegen.surface.backends import NumpyBackend
+from creaturegen.surface.extract import extract
+from creaturegen.surface.field64 import BodyField
+from creaturegen.surface.grid import make_grid
+from creaturegen.surface.mesh import Mesh
+from creaturegen.surface.sampling import sample_band
+from creaturegen.surface.skeleton import Skeleton, build_skeleton
+from creaturegen.surface.weights import LEAKAGE_MAX, SkinWeights, neighbour_matrix, skin_weights
+
+EXAMPLE_NAMES = ["beetle.json", "reference/quadruped.json", "lizard.json", "moth.json"]
+
+PINCER: dict[str, Any] = {
+    "name": "Pincer",
+    "seed": 1,
+    "scale": 1,
+    "parts": [
+        {
+            "id": "body",
+            "shape": "capsule",
+            "a": [0, 0.3, -0.2],
+            "b": [0, 0.3, 0.1],
+            "r": 0.16,
+            "color": "#808080",
+        },
+        # Child coordinates are relative to the parent's a end; the two tips meet at x = ±0.03.
+        {
+            "id": "claw-left",
+            "shape": "capsule",
+            "parent": "body",
+            "a": [0.14, 0.0, 0.25],
+            "b": [0.03, 0.0, 0.62],
+            "r": 0.05,
+            "color": "#a0a0a0",
+        },
+        {
+            "id": "claw-right",
+            "shape": "capsule",
+            "parent": "body",
+            "a": [-0.14, 0.0, 0.25],
+            "b": [-0.03, 0.0, 0.62],
+            "r": 0.05,
+            "color": "#a0a0a0",
+        },
+    ],
+}
+
+
+@dataclass(frozen=True)
+class Surface:
+    mesh: Mesh
+    field: BodyField
+    skeleton: Skeleton
+
+
+def _surface(spec: CharacterSpec, tier: str) -> Surface:
+    rig = compile_rig(spec)
+    grid = make_grid(rig.slots, rig.graph, tier, rig.slot_parts)
+    band = sample_band(grid, NumpyBackend(rig.graph, rig.slots), rig.graph, rig.slots, rig.body_scale)
+    field = BodyField(rig.graph, rig.slots)
+    return Surface(extract(field, band, rig.body_scale).mesh, field, build_skeleton(spec, rig))
+
+
+@cache
+def example(name: str) -> Surface:
+    spec = load_spec(EXAMPLES / name)
+    assert isinstance(spec, CharacterSpec)
+    return _surface(spec, "repeated")
+
+
+@cache
+def weights_of(name: str) -> SkinWeights:
+    s = example(name)
+    return skin_weights(s.mesh, s.field, s.skeleton)
+
+
+@cache
+def pincer() -> Surface:
+    spec = validate_bytes(json.dumps(PINCER).encode())
+    assert isinstance(spec, CharacterSpec)
+    return _surface(spec, "hero")
+
+
+@pytest.mark.parametrize("name", EXAMPLE_NAMES)
+def test_every_gate_passes(name: str) -> None:
+    w = weights_of(name)
+    failed = [f"{g.name}={g.value:.4g} (threshold {g.threshold}) {g.detail}" for g in w.gates if not g.passed]
+    assert not failed, failed
+    names = {g.name for g in w.gates}
+    assert names == {
+        "weights.partition",
+        "weights.nonnegative",
+        "weights.influences",
+        "weights.barrier_leakage",
+        "weights.continuity",
+        "weights.handle_coverage",
+    }
+
+
+@pytest.mark.parametrize("name", EXAMPLE_NAMES)
+def test_layout_and_partition_of_unity(name: str) -> None:
+    w = weights_of(name)
+    v = example(name).mesh.vertex_count
+    s = example(name).field.slots.shape[0]
+    assert w.indices.shape == (v, 4)
+    assert w.weights.shape == (v, 4)
+    assert w.indices.dtype.kind == "i"
+    assert w.weights.dtype == np.float64
+    assert ((w.indices >= 0) & (w.indices < s)).all()
+    assert np.abs(w.weights.sum(axis=1) - 1.0).max() <= 1e-12
+    assert (w.weights >= 0.0).all()
+    # Largest first; unused influences repeat the dominant slot with weight 0.
+    assert (np.diff(w.weights, axis=1) <= 0.0).all()
+    unused = w.weights == 0.0
+    assert (w.indices[unused] == np.broadcast_to(w.indices[:, :1], w.indices.shape)[unused]).all()
+    # Handles are pinned: weight exactly 1 on their slot.
+    pinned = w.handle >= 0
+    assert (w.indices[pinned, 0] == w.handle[pinned]).all()
+    assert (w.weights[pinned, 0] == 1.0).all()
+
+
+@pytest.mark.parametrize("name", EXAMPLE_NAMES)
+def test_every_surface_slot_has_handles(name: str) -> None:
+    w = weights_of(name)
+    s = example(name).field.slots.shape[0]
+    owned = np.bincount(w.owner, minlength=s)
+    pinned = np.bincount(w.handle[w.handle >= 0], minlength=s)
+    assert ((owned == 0) | (pinned > 0)).all(), [
+        example(name).skeleton.names[i] for i in np.flatnonzero(pinned == 0)
+    ]
+    # A buried slot (no owned vertex) carries no weight anywhere.
+    dense = w.dense(s)
+    for slot in np.flatnonzero(owned == 0):
+        assert dense[:, slot].max() == 0.0
+
+
+def test_partition_of_unity_survives_heavy_pruning() -> None:
+    s = example("reference/quadruped.json")
+    w = skin_weights(s.mesh, s.field, s.skeleton, max_influences=2)
+    assert w.indices.shape[1] == 2
+    assert w.gate("weights.partition").passed
+    assert w.gate("weights.influences").value <= 2
+    assert np.abs(w.weights.sum(axis=1) - 1.0).max() <= 1e-12
+    assert (w.weights >= 0.0).all()
+
+
+def test_beetle_contacts_are_cut_apart() -> None:
+    """At rest the beetle's legs on one side touch each other (siblings under the shell) and its
+    antennae touch the shell (their grandparent): none of these pairs are skeleton neighbours."""
+    s = example("beetle.json")
+    w = weights_of("beetle.json")
+    near = neighbour_matrix(s.skeleton)
+    edges = np.sort(s.mesh.edges(), axis=1)
+    a, b = w.owner[edges[:, 0]], w.owner[edges[:, 1]]
+    touching = {
+        (s.skeleton.names[i], s.skeleton.names[j]) for i, j in zip(a, b, strict=True) if not near[i, j]
+    }
+    assert ("part.antenna-left", "part.shell") in touching | {(y, x) for x, y in touching}
+    assert any(
+        "leg-mid-left" in x and "leg-front-left" in y for x, y in touching | {(y, x) for x, y in touching}
+    )
+    assert w.barrier_edges > 0
+    foreign = ~near[w.owner[:, None], w.indices] & (w.weights > 0.0)
+    assert not foreign.any()
+
+
+def test_removing_the_barrier_fails_the_leakage_gate() -> None:
+    s = pincer()
+    near = neighbour_matrix(s.skeleton)
+    left, right = s.skeleton.names.index("part.claw-left"), s.skeleton.names.index("part.claw-right")
+    assert not near[left, right], "the claws must be skeleton non-neighbours for this test to mean anything"
+
+    kept = skin_weights(s.mesh, s.field, s.skeleton)
+    assert kept.barrier_edges > 0, "the claw tips must touch"
+    assert kept.passed, [(g.name, g.value) for g in kept.gates if not g.passed]
+    assert kept.gate("weights.barrier_leakage").value <= LEAKAGE_MAX
+
+    leaky = skin_weights(s.mesh, s.field, s.skeleton, barrier=False)
+    gate = leaky.gate("weights.barrier_leakage")
+    assert not gate.passed
+    assert gate.value > 0.1
+    # The leak is the other claw's weight at the touching tips.
+    dense = leaky.dense(s.field.slots.shape[0])
+    assert dense[leaky.owner == left, right].max() > 0.1
+    assert dense[leaky.owner == right, left].max() > 0.1
+
+
+def test_weights_are_deterministic() -> None:
+    s = example("moth.json")
+    a = skin_weights(s.mesh, s.field, s.skeleton)
+    b = skin_weights(s.mesh, s.field, s.skeleton)
+    assert np.array_equal(a.indices, b.indices)
+    assert np.array_equal(a.weights, b.weights)
+
+
+def test_rejects_zero_influences() -> None:
+    s = pincer()
+    with pytest.raises(ValueError, match="max_influences"):
+        skin_weights(s.mesh, s.field, s.skeleton, max_influences=0)
