@@ -16,8 +16,9 @@ this run:
   recorded as null with the reason), or where numpy sampled the band faster. ``dense_backend`` names the
   backend that was faster at band sampling in this run, the baseline the headline saving uses. Dense
   signs are checked against the band's sign lattice away from zero (``|d| ≥ δ``, the settle band);
-* **extraction** (``surface/extract.py: extract`` on the numpy band) and **validation** (``mesh_gates``
-  with the build's 15° minimum-angle bound and the derived component count, plus ``component_policy``),
+* **extraction** (``surface/extract.py: extract`` on the numpy band) and **validation**
+  (``surface/build.py: surface_mesh_gates``: the build's gates and thresholds and the component policy,
+  at the first lattice only: the build's √2 refinement on a failed gate is not benchmarked),
   each timed once: vertex and triangle counts, every gate as measured, the names of failed gates.
 
 Sampling variants run interleaved in rounds whose order rotates, after a 64-point warm-up call per
@@ -52,10 +53,11 @@ import numpy.typing as npt
 from creaturegen.rig import CompiledRig, compile_rig
 from creaturegen.spec import CharacterSpec, load_spec
 from creaturegen.surface.backends import BackendUnavailableError, FieldBackend, NumpyBackend, make_backend
-from creaturegen.surface.components import ComponentPolicy, component_policy
+from creaturegen.surface.build import surface_mesh_gates
+from creaturegen.surface.components import ComponentPolicy
 from creaturegen.surface.extract import extract
 from creaturegen.surface.field64 import BodyField
-from creaturegen.surface.gates import SurfaceGate, mesh_gates
+from creaturegen.surface.gates import SurfaceGate
 from creaturegen.surface.grid import ERROR_TARGET, Grid, GridTooFineError, make_grid, smallest_radius
 from creaturegen.surface.sampling import SIGN_SETTLE_FACTOR, NarrowBand, sample_band
 from creaturegen.surface.skeleton import build_skeleton
@@ -67,8 +69,6 @@ EXAMPLES = REPO / "examples"
 TIERS = tuple(ERROR_TARGET)  # hero, repeated, distant
 BACKEND_NAMES = ("numpy", "wgpu")
 
-#: The build's minimum-angle bound on the 1st-percentile smallest triangle angle (surface/build.py).
-MIN_ANGLE_P1_DEG = 15.0
 #: numpy dense passes only up to this many lattice nodes (unless numpy was the faster band sampler).
 NUMPY_DENSE_MAX_NODES = 2_000_000
 #: Nodes per backend call in the dense pass (whole x-planes, at least one).
@@ -269,40 +269,9 @@ def measure_tier(
     mesh = ex.mesh
 
     def validate() -> tuple[list[SurfaceGate], ComponentPolicy]:
-        policy = component_policy(mesh, rig.slots, rig.graph, names)
-        gates = mesh_gates(
-            mesh,
-            length_scale=length,
-            distance=field.distance,
-            gradient=field.gradient,
-            expected_components=policy.expected,
-            min_angle_bound_deg=MIN_ANGLE_P1_DEG,
-        )
-        return gates, policy
+        return surface_mesh_gates(rig, ex, field, names, grid.spacing)
 
     t_validate, (gates, policy) = _timed(validate)
-    strays = f"components {list(policy.strays)} own no slot" if policy.strays else ""
-    gates = [
-        *gates,
-        SurfaceGate("strayComponents", float(len(policy.strays)), 0.0, "components", "max", strays),
-        SurfaceGate(
-            "splitBlendRoots",
-            float(len(policy.split_roots)),
-            0.0,
-            "roots",
-            "max",
-            ", ".join(policy.split_roots),
-        ),
-        SurfaceGate(
-            "unownedSlots",
-            float(len(policy.unowned_slots)),
-            0.0,
-            "slots",
-            "max",
-            ", ".join(policy.unowned_slots),
-        ),
-        SurfaceGate("unbracketedEdges", float(ex.unresolved_edges), 0.0, "vertices", "max"),
-    ]
     failed = [g.name for g in gates if not g.passed]
 
     record.update(
@@ -545,9 +514,8 @@ def main(argv: Sequence[str] | None = None) -> int:
             "numpy_dense_max_nodes": NUMPY_DENSE_MAX_NODES,
             "dense_backend": "per tier, the backend with the faster narrow-band sampling in this run",
             "extraction_and_validation": "timed once each, on the numpy band",
-            "validation": "mesh_gates(expected_components=component_policy(...).expected, "
-            f"min_angle_bound_deg={MIN_ANGLE_P1_DEG}) + component_policy, plus strayComponents, "
-            "splitBlendRoots, unownedSlots and unbracketedEdges gates as surface/build.py adds them",
+            "validation": "surface/build.py surface_mesh_gates: the build's mesh gates and thresholds "
+            "and its component policy, on the first lattice (no refinement)",
             "ratios": "dense_over_band: dense pass / band sampling per backend; numpy_over_wgpu: the same "
             "variant on both backends; all from best times of this run",
         },

@@ -114,7 +114,7 @@ def test_surface_benchmark_smoke(tmp_path: Path, capsys: pytest.CaptureFixture[s
     assert _positive_finite(validation["seconds"])
     gates = {g["name"]: g for g in validation["gates"]}
     assert len(gates) == validation["gates_total"]
-    assert {*COMBINATORIAL_GATES, "components", "inverted", "surfaceToZeroSet", "splitBlendRoots"} <= set(
+    assert {*COMBINATORIAL_GATES, "components", "inverted", "surfaceToZeroSet", "strayComponents"} <= set(
         gates
     )
     assert validation["failed"] == [name for name, g in gates.items() if not g["passed"]]

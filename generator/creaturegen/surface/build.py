@@ -237,6 +237,39 @@ def _fail_on(gates: list[SurfaceGate], where: str) -> None:
         )
 
 
+def surface_mesh_gates(
+    rig: CompiledRig, ex: Extraction, rest_field: BodyField, names: tuple[str, ...], spacing: float
+) -> tuple[list[SurfaceGate], ComponentPolicy]:
+    """Every mesh gate at the pipeline's thresholds, plus the component policy's (one list for the
+    build and bench/surface, so both judge a mesh the same way)."""
+    policy = component_policy(ex.mesh, rig.slots, rig.graph, names)
+    gates = mesh_gates(
+        ex.mesh,
+        length_scale=rig.body_scale,
+        distance=rest_field.distance,
+        gradient=rest_field.gradient,
+        expected_components=policy.expected,
+        min_angle_bound_deg=MIN_ANGLE_P1_DEG,
+        vertex_normal_max_deg=VERTEX_NORMAL_MAX_DEG,
+        face_normal_max_deg=FACE_NORMAL_MAX_DEG,
+        smooth=rest_field.smooth(CREASE_BAND_CELLS * spacing),
+    )
+    strays = f"components {list(policy.strays)} own no slot" if policy.strays else ""
+    gates += [
+        SurfaceGate("strayComponents", float(len(policy.strays)), 0.0, "components", "max", strays),
+        SurfaceGate(
+            "unownedSlots",
+            float(len(policy.unowned_slots)),
+            0.0,
+            "slots",
+            "max",
+            ", ".join(policy.unowned_slots),
+        ),
+        SurfaceGate("unbracketedEdges", float(ex.unresolved_edges), 0.0, "vertices", "max"),
+    ]
+    return gates, policy
+
+
 @dataclass(frozen=True)
 class ValidatedMesh:
     """The extracted mesh at the first lattice whose mesh gates pass (or the finest tried)."""
@@ -275,37 +308,7 @@ def validated_mesh(
         timings["extraction"] += time.perf_counter() - t
         progress(f"extracted {mesh.vertex_count:,} vertices, {mesh.face_count:,} triangles")
         t = time.perf_counter()
-        policy = component_policy(mesh, rig.slots, rig.graph, skeleton.names)
-        gates = mesh_gates(
-            mesh,
-            length_scale=rig.body_scale,
-            distance=rest_field.distance,
-            gradient=rest_field.gradient,
-            expected_components=policy.expected,
-            min_angle_bound_deg=MIN_ANGLE_P1_DEG,
-            vertex_normal_max_deg=VERTEX_NORMAL_MAX_DEG,
-            face_normal_max_deg=FACE_NORMAL_MAX_DEG,
-            smooth=rest_field.smooth(CREASE_BAND_CELLS * grid.spacing),
-        )
-        gates += [
-            SurfaceGate(
-                "strayComponents",
-                float(len(policy.strays)),
-                0.0,
-                "components",
-                "max",
-                f"components {list(policy.strays)} own no slot" if policy.strays else "",
-            ),
-            SurfaceGate(
-                "unownedSlots",
-                float(len(policy.unowned_slots)),
-                0.0,
-                "slots",
-                "max",
-                ", ".join(policy.unowned_slots),
-            ),
-            SurfaceGate("unbracketedEdges", float(ex.unresolved_edges), 0.0, "vertices", "max"),
-        ]
+        gates, policy = surface_mesh_gates(rig, ex, rest_field, skeleton.names, grid.spacing)
         timings["validation"] += time.perf_counter() - t
         failed = [g.name for g in gates if not g.passed]
         progress(
