@@ -42,6 +42,7 @@ from .grid import Grid, make_grid
 from .mesh import Mesh
 from .sampling import sample_band
 from .skeleton import Skeleton, build_skeleton
+from .topology import components
 from .weights import skin_weights
 
 F64 = npt.NDArray[np.float64]
@@ -255,6 +256,9 @@ def surface_mesh_gates(
         smooth=rest_field.smooth(CREASE_BAND_CELLS * spacing),
     )
     strays = f"components {list(policy.strays)} own no slot" if policy.strays else ""
+    gates = [
+        _name_parts(g, ex.mesh, policy, names) if g.name == "euler" and not g.passed else g for g in gates
+    ]
     gates += [
         SurfaceGate("strayComponents", float(len(policy.strays)), 0.0, "components", "max", strays),
         SurfaceGate(
@@ -268,6 +272,19 @@ def surface_mesh_gates(
         SurfaceGate("unbracketedEdges", float(ex.unresolved_edges), 0.0, "vertices", "max"),
     ]
     return gates, policy
+
+
+def _name_parts(
+    gate: SurfaceGate, mesh: Mesh, policy: ComponentPolicy, names: tuple[str, ...]
+) -> SurfaceGate:
+    """The euler gate's detail rewritten to name the parts of every component that is not a sphere."""
+    found = components(mesh)
+    bad = [c for c in range(found.count) if int(found.euler[c]) != 2]
+    parts = []
+    for c in bad:
+        owned = ", ".join(n for n, o in zip(names, policy.owners, strict=True) if o == c)
+        parts.append(f"genus {float(found.genus[c]):g} in the component of {owned}")
+    return SurfaceGate(gate.name, gate.value, gate.threshold, gate.unit, gate.direction, "; ".join(parts))
 
 
 @dataclass(frozen=True)
