@@ -360,7 +360,7 @@ def build_surface(
     strict: bool = True,
 ) -> SurfaceBuild:
     """The validated reference surface of one body at one tier (from the cache when it is there)."""
-    extra: dict[str, object] = {"creaturegen": __version__}
+    extra: dict[str, object] = {"creaturegen": __version__, "sources": identity.source_digest()}
     compiler = identity.compiler_signature(rig, tier, extra)
     geometry = rig_signatures(rig).geometryDigest
     settings = identity.settings_digest(tier, extra)

@@ -14,6 +14,8 @@ from __future__ import annotations
 
 import hashlib
 import json
+from functools import cache
+from pathlib import Path
 
 import numpy as np
 import numpy.typing as npt
@@ -50,6 +52,22 @@ def surface_settings(tier: str) -> dict[str, object]:
             "normalAgreement": correct.NORMAL_AGREEMENT,
         },
     }
+
+
+#: Packages whose code shapes the surface: any edit to them is a different compiler, so a stale cache
+#: entry is never served while the version number stands still during development.
+SOURCE_PACKAGES = ("surface", "field", "rig", "candidates")
+
+
+@cache
+def source_digest() -> str:
+    root = Path(__file__).resolve().parent.parent
+    h = hashlib.sha256()
+    for package in SOURCE_PACKAGES:
+        for path in sorted((root / package).glob("*.py")):
+            h.update(f"{package}/{path.name}".encode())
+            h.update(path.read_bytes())
+    return h.hexdigest()
 
 
 def settings_digest(tier: str, extra: dict[str, object]) -> str:
