@@ -29,8 +29,6 @@ from __future__ import annotations
 import argparse
 import json
 import math
-import os
-import platform
 import statistics
 import subprocess
 import sys
@@ -40,6 +38,7 @@ from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import Any
 
+from benchlib import machine
 from creaturegen.frost.brush import Segment
 from creaturegen.frost.params import scaled_size
 from creaturegen.frost.path import conformance_segments
@@ -536,28 +535,11 @@ def second_page(first: LabPage, url: str, timeout_s: float = 90.0) -> LabPage:
 
 
 def environment(page: LabPage) -> dict[str, Any]:
-    try:
-        commit = subprocess.run(
-            ["git", "rev-parse", "HEAD"], cwd=REPO, capture_output=True, text=True, check=True
-        ).stdout.strip()
-        dirty = bool(
-            subprocess.run(
-                ["git", "status", "--porcelain"], cwd=REPO, capture_output=True, text=True, check=True
-            ).stdout.strip()
-        )
-    except (OSError, subprocess.CalledProcessError):
-        commit, dirty = None, None
     browser = page.page.context.browser
     return {
-        "python": platform.python_version(),
-        "cpu_count": os.cpu_count(),
-        "cpus_usable": len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else os.cpu_count(),
-        "platform": platform.platform(),
-        "machine": platform.machine(),
+        **machine(),
         "chromium": str(page.executable),
         "chromium_version": browser.version if browser is not None else None,
-        "git_commit": commit,
-        "git_dirty": dirty,
     }
 
 

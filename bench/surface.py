@@ -38,9 +38,6 @@ import gc
 import importlib.metadata
 import json
 import math
-import os
-import platform
-import subprocess
 import sys
 import time
 from collections.abc import Callable, Sequence
@@ -50,6 +47,7 @@ from typing import Any, TypeVar
 import numpy as np
 import numpy.typing as npt
 
+from benchlib import machine
 from creaturegen.rig import CompiledRig, compile_rig
 from creaturegen.spec import CharacterSpec, load_spec
 from creaturegen.surface.backends import BackendUnavailableError, FieldBackend, NumpyBackend, make_backend
@@ -395,33 +393,10 @@ def wgpu_adapter() -> dict[str, Any]:
 
 def environment() -> dict[str, Any]:
     try:
-        commit = subprocess.run(
-            ["git", "rev-parse", "HEAD"], cwd=REPO, capture_output=True, text=True, check=True
-        ).stdout.strip()
-        dirty = bool(
-            subprocess.run(
-                ["git", "status", "--porcelain"], cwd=REPO, capture_output=True, text=True, check=True
-            ).stdout.strip()
-        )
-    except (OSError, subprocess.CalledProcessError):
-        commit, dirty = None, None
-    try:
         wgpu_version: str | None = importlib.metadata.version("wgpu")
     except importlib.metadata.PackageNotFoundError:
         wgpu_version = None
-    return {
-        "python": platform.python_version(),
-        "numpy": np.__version__,
-        "wgpu_py": wgpu_version,
-        "wgpu_adapter": wgpu_adapter(),
-        "cpu_count": os.cpu_count(),
-        "cpus_usable": len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else os.cpu_count(),
-        "platform": platform.platform(),
-        "machine": platform.machine(),
-        "processor": platform.processor() or None,
-        "git_commit": commit,
-        "git_dirty": dirty,
-    }
+    return {**machine(), "numpy": np.__version__, "wgpu_py": wgpu_version, "wgpu_adapter": wgpu_adapter()}
 
 
 def _f(value: float | None, spec: str) -> str:

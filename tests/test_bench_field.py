@@ -2,47 +2,19 @@
 
 from __future__ import annotations
 
-import importlib.util
 import json
 import math
-import sys
-from collections.abc import Iterator
 from pathlib import Path
-from types import ModuleType
-from typing import Any
 
 import pytest
 
-from conftest import EXAMPLES, REPO
-
-
-def _load_bench() -> ModuleType:
-    spec = importlib.util.spec_from_file_location("bench_field", REPO / "bench" / "field.py")
-    assert spec is not None
-    assert spec.loader is not None
-    module = importlib.util.module_from_spec(spec)
-    sys.modules[spec.name] = module  # dataclasses look their module up while the class is created
-    spec.loader.exec_module(module)
-    return module
-
-
-def _numbers(value: Any, path: str = "") -> Iterator[tuple[str, float]]:
-    if isinstance(value, bool):
-        return
-    if isinstance(value, int | float):
-        yield path, float(value)
-    elif isinstance(value, dict):
-        for key, item in value.items():
-            yield from _numbers(item, f"{path}.{key}")
-    elif isinstance(value, list):
-        for i, item in enumerate(value):
-            yield from _numbers(item, f"{path}[{i}]")
+from conftest import EXAMPLES, json_numbers, load_bench
 
 
 def test_field_benchmark_writes_finite_positive_json(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
-    bench = _load_bench()
+    bench = load_bench("field")
     out = tmp_path / "field.json"
     example = EXAMPLES / "reference" / "flyer.json"
     assert bench.main(["--points", "300", "--repeats", "1", "--out", str(out), str(example)]) == 0
@@ -71,7 +43,7 @@ def test_field_benchmark_writes_finite_positive_json(
         model["predicted_forbidden_over_snap_7P_over_k_used"] == 7 * result["slot_count_P"] / result["k_used"]
     )
 
-    numbers = list(_numbers(report))
+    numbers = list(json_numbers(report))
     assert len(numbers) > 30
     bad = [(where, x) for where, x in numbers if not (math.isfinite(x) and x > 0)]
     assert not bad, bad

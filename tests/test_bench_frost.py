@@ -3,18 +3,13 @@
 
 from __future__ import annotations
 
-import importlib.util
 import json
 import math
-import sys
-from collections.abc import Iterator
 from pathlib import Path
-from types import ModuleType
-from typing import Any
 
 import pytest
 
-from conftest import REPO
+from conftest import json_numbers, load_bench
 
 #: 192x128: the budgeted history (x0.25) is 48x32, two 32-texel tiles, so a dab in one tile dispatches
 #: fewer texels than the whole field (at 96x64 the history fits in one tile and would not).
@@ -22,32 +17,9 @@ CANVAS = (192, 128)
 FRAMES = 5
 
 
-def _load_bench() -> ModuleType:
-    spec = importlib.util.spec_from_file_location("bench_frost", REPO / "bench" / "frost.py")
-    assert spec is not None
-    assert spec.loader is not None
-    module = importlib.util.module_from_spec(spec)
-    sys.modules[spec.name] = module
-    spec.loader.exec_module(module)
-    return module
-
-
-def _numbers(value: Any, path: str = "") -> Iterator[tuple[str, float]]:
-    if isinstance(value, bool):
-        return
-    if isinstance(value, int | float):
-        yield path, float(value)
-    elif isinstance(value, dict):
-        for key, item in value.items():
-            yield from _numbers(item, f"{path}.{key}")
-    elif isinstance(value, list):
-        for i, item in enumerate(value):
-            yield from _numbers(item, f"{path}[{i}]")
-
-
 @pytest.mark.browser
 def test_frost_benchmark_smoke(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
-    bench = _load_bench()
+    bench = load_bench("frost")
     out = tmp_path / "frost.json"
     canvas = f"{CANVAS[0]}x{CANVAS[1]}"
     args = ["--out", str(out), "--canvas", canvas, "--repeats", "1", "--frames", str(FRAMES)]
@@ -63,7 +35,7 @@ def test_frost_benchmark_smoke(tmp_path: Path, capsys: pytest.CaptureFixture[str
     assert report["parameters"]["repeats"] == 1
     assert report["parameters"]["frames"] == FRAMES
     assert all(errors == [] for errors in report["gpu_errors"].values()), report["gpu_errors"]
-    bad = [(where, x) for where, x in _numbers(report) if not math.isfinite(x)]
+    bad = [(where, x) for where, x in json_numbers(report) if not math.isfinite(x)]
     assert not bad, bad
 
     # Tiers: one package, three tiers, the history shrinking with the tier's scale.

@@ -4,44 +4,16 @@ is closed and manifold), never timings."""
 
 from __future__ import annotations
 
-import importlib.util
 import json
 import math
-import sys
-from collections.abc import Iterator
 from pathlib import Path
-from types import ModuleType
-from typing import Any
 
 import pytest
 
-from conftest import REPO
+from conftest import json_numbers, load_bench
 
 #: Gates that hold by construction of the sign-lattice mesher (surface/extract.py) at any resolution.
 COMBINATORIAL_GATES = ("watertight", "edgeManifold", "vertexManifold", "winding", "degenerate")
-
-
-def _load_bench() -> ModuleType:
-    spec = importlib.util.spec_from_file_location("bench_surface", REPO / "bench" / "surface.py")
-    assert spec is not None
-    assert spec.loader is not None
-    module = importlib.util.module_from_spec(spec)
-    sys.modules[spec.name] = module
-    spec.loader.exec_module(module)
-    return module
-
-
-def _numbers(value: Any, path: str = "") -> Iterator[tuple[str, float]]:
-    if isinstance(value, bool):
-        return
-    if isinstance(value, int | float):
-        yield path, float(value)
-    elif isinstance(value, dict):
-        for key, item in value.items():
-            yield from _numbers(item, f"{path}.{key}")
-    elif isinstance(value, list):
-        for i, item in enumerate(value):
-            yield from _numbers(item, f"{path}[{i}]")
 
 
 def _positive_finite(x: object) -> bool:
@@ -49,7 +21,7 @@ def _positive_finite(x: object) -> bool:
 
 
 def test_surface_benchmark_smoke(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
-    bench = _load_bench()
+    bench = load_bench("surface")
     out = tmp_path / "surface.json"
     args = ["--examples", "reference/biped.json", "--tiers", "distant", "--repeats", "1", "--out", str(out)]
     assert bench.main(args) == 0
@@ -61,7 +33,7 @@ def test_surface_benchmark_smoke(tmp_path: Path, capsys: pytest.CaptureFixture[s
     assert report["parameters"]["tiers"] == ["distant"]
     assert report["parameters"]["repeats"] == 1
     assert report["parameters"]["examples"] == ["reference/biped.json"]
-    bad = [(where, x) for where, x in _numbers(report) if not math.isfinite(x)]
+    bad = [(where, x) for where, x in json_numbers(report) if not math.isfinite(x)]
     assert not bad, bad
 
     (result,) = report["results"]

@@ -10,8 +10,8 @@ cone's side distance), and ``exp``/``log`` are the adapter's own. Each is a roun
 intermediate no larger than the rig, so the gap is a few ulp of ``L = body_scale``; the bound
 ``1e-5·L + 4 ulp(|d|)`` leaves room for a real GPU's looser ``exp``/``log``/division while staying
 orders of magnitude below any formula error (the taper term alone is ~5e-3·L on the beetle).
-Observed on Mesa lavapipe (llvmpipe, LLVM 15): ``max |Δd| / L`` ≤ 8.2e-8 on every example (flyer),
-exactly 0 on hexapod, hopper and quadruped (see ``OBSERVED``).
+Rigs without round cones or log-sum-exp ops agree bit for bit on lavapipe; a failure message prints
+this run's ``max |Δd| / L``.
 """
 
 from __future__ import annotations
@@ -42,19 +42,6 @@ SEED = 20240611
 TOL_L = 1e-5
 #: Relative part, in ulp of |d|.
 TOL_ULP = 4
-#: max |Δd| / L measured on Mesa lavapipe (llvmpipe, LLVM 15) with ``probe_points``; quoted in the
-#: failure message. Exactly 0 where every slot is a tapered capsule and every op a poly smin.
-OBSERVED = {
-    "beetle.json": 3.03e-8,  # lse: the adapter's exp/log
-    "lizard.json": 4.50e-8,  # round cones: FMA contraction in the side distance
-    "moth.json": 3.88e-8,
-    "biped.json": 3.91e-8,
-    "flyer.json": 8.11e-8,
-    "hexapod.json": 0.0,
-    "hopper.json": 0.0,
-    "quadruped.json": 0.0,
-    "swimmer.json": 9.46e-9,
-}
 
 
 @pytest.fixture(scope="module", autouse=True)
@@ -165,8 +152,7 @@ def test_wgpu_matches_numpy_float32_on_every_creature(path: Path) -> None:
     assert np.count_nonzero(np.abs(ref) < 0.01 * rig.body_scale) >= 256
     worst = int(np.argmax(excess))
     assert excess.max() <= 0.0, (
-        f"{path.name}: max |Δd|/L = {relative:.3g} exceeds 1e-5·L + 4 ulp at {points[worst].tolist()} "
-        f"(lavapipe gave {OBSERVED[path.name]:.3g})"
+        f"{path.name}: max |Δd|/L = {relative:.3g} exceeds 1e-5·L + 4 ulp at {points[worst].tolist()}"
     )
 
 

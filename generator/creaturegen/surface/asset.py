@@ -239,24 +239,14 @@ class _BinBuilder:
         kind: str,
         *,
         target: int | None,
-        stride: int | None = None,
         minmax: bool = False,
     ) -> int:
         count = int(data.shape[0])
         little = np.ascontiguousarray(data, dtype=_COMPONENT_DTYPES[component])
-        if stride is not None:
-            # Pad every element to `stride` bytes (zeros), for elements smaller than 4 bytes.
-            rows = little.reshape(count, -1).view(np.uint8)
-            padded = np.zeros((count, stride), dtype=np.uint8)
-            padded[:, : rows.shape[1]] = rows
-            raw = padded.tobytes()
-        else:
-            raw = little.tobytes()
+        raw = little.tobytes()
         view: dict[str, object] = {"buffer": 0, "byteOffset": self.length, "byteLength": len(raw)}
         if target is not None:
             view["target"] = target
-        if stride is not None:
-            view["byteStride"] = stride
         self.views.append(view)
         self.chunks.append(raw + b"\0" * (_pad4(len(raw)) - len(raw)))
         self.length += _pad4(len(raw))

@@ -155,18 +155,6 @@ def candidate_index(
 SEAM_WEIGHT = 0.01
 
 
-def _sweep_poses(
-    skeleton: Skeleton, slots: F64, choice: deform.DeformationChoice
-) -> list[tuple[int, deform.Pose]]:
-    """The extreme poses of every joint's sweep: both bend axes at the limit, and the full twist."""
-    poses = []
-    bend, twist = np.radians(choice.bend_max_deg), np.radians(choice.twist_max_deg)
-    for _, child in skeleton.joints:
-        for axis, b, t in ((0, bend, 0.0), (0, -bend, 0.0), (1, bend, 0.0), (1, -bend, 0.0), (0, 0.0, twist)):
-            poses.append((child, deform.pose_joint(skeleton, slots, child, axis, b, t)))
-    return poses
-
-
 def seam(skeleton: Skeleton, weights: tuple[npt.NDArray[np.int32], F64], child: int) -> npt.NDArray[np.bool_]:
     """Vertices weighted on both sides of the joint above ``child``: the only ones a joint pose deforms.
 
@@ -193,7 +181,8 @@ def correction_sweep(
 
     The region is every seam vertex whose skinned position misses the posed field by more than
     SKIN_ERROR_FACTOR·L in some pose of its joint; each pose is then corrected over the region's seam
-    vertices and the worst report kept. Returns (region, worst report, worst skin-only seam error in m).
+    vertices that have a candidate program (the caller gates those that have none) and the worst report
+    kept. Returns (region, worst report, worst skin-only seam error in m).
     """
     owner = weights[0][:, 0]
     radius = np.maximum(rig.slots[owner, col.RA], rig.slots[owner, col.RB])
@@ -202,7 +191,14 @@ def correction_sweep(
     region = np.zeros(mesh.vertex_count, dtype=bool)
     posed = []
     worst_skin = 0.0
-    for child, pose in _sweep_poses(skeleton, rig.slots, choice):
+    extremes = [
+        (child, pose)
+        for _, child in skeleton.joints
+        for _, pose in deform.sweep_poses(
+            skeleton, rig.slots, child, choice.bend_max_deg, choice.twist_max_deg, steps=1
+        )
+    ]
+    for child, pose in extremes:
         on_seam = seam(skeleton, weights, child)
         if not on_seam.any():
             continue
@@ -215,10 +211,10 @@ def correction_sweep(
         worst_skin = max(worst_skin, float(error.max()))
         region |= error > gate
         posed.append((posed_field, skinned, on_seam))
-    region &= programs != NO_PROGRAM
+    covered = region & (programs != NO_PROGRAM)
     worst: CorrectionReport | None = None
     for posed_field, skinned, on_seam in posed:
-        _, report = correct(posed_field, mesh, skinned.positions, skinned.normals, region & on_seam, trust)
+        _, report = correct(posed_field, mesh, skinned.positions, skinned.normals, covered & on_seam, trust)
         if worst is None or report.residual_after > worst.residual_after:
             worst = report
     if worst is None:
@@ -430,11 +426,11 @@ def build_surface(
         ),
         SurfaceGate(
             "correctionUncovered",
-            float(np.count_nonzero(programs == NO_PROGRAM)),
-            0.0 if not candidate_note else float(mesh.vertex_count),
+            float(np.count_nonzero(region & (programs == NO_PROGRAM))),
+            0.0,
             "vertices",
             "max",
-            candidate_note,
+            candidate_note or "region vertices outside every candidate region",
         ),
     ]
     gates += correction_gates

@@ -40,7 +40,7 @@ from ..rig.graph import BlendGraph
 from . import topology
 from .field64 import BodyField
 from .gates import SurfaceGate
-from .mesh import Mesh
+from .mesh import Mesh, angles_deg, unit_rows
 from .skeleton import Skeleton
 
 F64 = npt.NDArray[np.float64]
@@ -161,12 +161,6 @@ def rotation_matrix(axis: npt.ArrayLike, angle: float) -> F64:
     u = u / np.linalg.norm(u)
     k = np.array([[0.0, -u[2], u[1]], [u[2], 0.0, -u[0]], [-u[1], u[0], 0.0]])
     result: F64 = np.eye(3) + math.sin(angle) * k + (1.0 - math.cos(angle)) * (k @ k)
-    return result
-
-
-def _unit(v: F64) -> F64:
-    n = np.linalg.norm(v, axis=-1, keepdims=True)
-    result: F64 = v / np.where(n > 0, n, 1.0)
     return result
 
 
@@ -427,7 +421,7 @@ def _cor(vertices: F64, indices: I64, weights: F64, pose: Pose, centers: F64) ->
     """
     q = matrix_to_quaternion(pose.rotations)[indices]
     signs, flips = _hemisphere(q, weights)
-    blended = _unit(np.einsum("vk,vkc->vc", weights * signs, q))
+    blended = unit_rows(np.einsum("vk,vkc->vc", weights * signs, q))
     rotation = quaternion_to_matrix(blended)
     delta = np.einsum("vk,vkij->vij", weights, (pose.rotations - np.eye(3))[indices])
     shift = np.einsum("vk,vki->vi", weights, pose.translations[indices])
@@ -456,7 +450,7 @@ def skin_lbs(
     """Linear blend skinning; normals by the cofactor (inverse-transpose) of the blended matrix."""
     idx, w = _as_arrays(indices, weights)
     positions, matrices = _lbs(vertices, idx, w, pose)
-    return Skinned(positions, _unit(np.einsum("vij,vj->vi", _cofactor(matrices), normals)), 0)
+    return Skinned(positions, unit_rows(np.einsum("vij,vj->vi", _cofactor(matrices), normals)), 0)
 
 
 def skin_dq(
@@ -465,7 +459,7 @@ def skin_dq(
     """Dual-quaternion skinning with per-vertex antipodality handling; normals by the blended rotation."""
     idx, w = _as_arrays(indices, weights)
     positions, rotation, flips = _dq(vertices, idx, w, pose)
-    return Skinned(positions, _unit(np.einsum("vij,vj->vi", rotation, normals)), flips)
+    return Skinned(positions, unit_rows(np.einsum("vij,vj->vi", rotation, normals)), flips)
 
 
 def skin_cor(
@@ -479,7 +473,7 @@ def skin_cor(
     """Optimised-centre-of-rotation skinning; ``centers`` from :func:`centers_of_rotation`."""
     idx, w = _as_arrays(indices, weights)
     positions, rotation, flips = _cor(vertices, idx, w, pose, centers)
-    return Skinned(positions, _unit(np.einsum("vij,vj->vi", rotation, normals)), flips)
+    return Skinned(positions, unit_rows(np.einsum("vij,vj->vi", rotation, normals)), flips)
 
 
 def vertex_areas(mesh: Mesh) -> F64:
@@ -756,11 +750,6 @@ def _edge_faces(faces: I64) -> I64:
     return result
 
 
-def _angles_deg(u: F64, v: F64) -> F64:
-    result: F64 = np.degrees(np.arctan2(np.linalg.norm(np.cross(u, v), axis=1), np.einsum("ij,ij->i", u, v)))
-    return result
-
-
 def sweep_poses(
     skeleton: Skeleton,
     rest_slots: F64,
@@ -970,7 +959,7 @@ def _joint_sweep(
             shown = visible[fold_edges].all(axis=1)
             if shown.any():
                 e = fold_edges[shown]
-                turn = _angles_deg(normals[e[:, 0]], normals[e[:, 1]]) - fold_dihedral[shown]
+                turn = angles_deg(normals[e[:, 0]], normals[e[:, 1]]) - fold_dihedral[shown]
                 dihedral[p, k] = max(float(turn.max()), 0.0)
             against = (np.einsum("ij,ij->i", normals, rest_normals) < 0) & (
                 np.einsum("ij,ij->i", normals, turned_normals) < 0
@@ -1089,7 +1078,7 @@ def choose_deformation(
     faces = mesh.faces.astype(np.int64)
     corners = mesh.vertices[faces]
     triple = _triple(corners)
-    face_normals = _unit(np.cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0]))
+    face_normals = unit_rows(np.cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0]))
     edge_faces = _edge_faces(faces)
     rest = _Rest(
         vertices=mesh.vertices,
@@ -1098,7 +1087,7 @@ def choose_deformation(
         volume=float(triple.sum()) / 6.0,
         face_normals=face_normals,
         edge_faces=edge_faces,
-        rest_dihedral=_angles_deg(face_normals[edge_faces[:, 0]], face_normals[edge_faces[:, 1]]),
+        rest_dihedral=angles_deg(face_normals[edge_faces[:, 0]], face_normals[edge_faces[:, 1]]),
         centers=centers if centers is not None else centers_of_rotation(mesh, idx, w),
     )
     methods: list[Method] = ["lbs"] * len(skeleton.parent)

@@ -25,7 +25,7 @@ import scipy.sparse as sp
 from skimage.measure import marching_cubes
 
 from .field64 import BodyField, project
-from .mesh import Mesh
+from .mesh import Mesh, unit_rows
 from .sampling import NarrowBand
 
 F64 = npt.NDArray[np.float64]
@@ -158,12 +158,6 @@ def _adjacency(vertex_count: int, faces: npt.NDArray[np.int64]) -> sp.csr_matrix
     return a
 
 
-def _unit(v: F64) -> F64:
-    n = np.linalg.norm(v, axis=1, keepdims=True)
-    result: F64 = v / np.where(n > 0, n, 1.0)
-    return result
-
-
 def _inverted_faces(vertices: F64, faces: npt.NDArray[np.int64], normals: F64) -> F64:
     """Per-face dot of the face normal with the mean analytic normal of its corners (≤ 0: inverted)."""
     c = vertices[faces]
@@ -178,13 +172,13 @@ def relax(field: BodyField, vertices: F64, faces: npt.NDArray[np.int64]) -> tupl
     degree = np.asarray(adjacency.sum(axis=1)).reshape(-1)
     reverted = 0
     v = vertices
-    normals = _unit(field.gradient(v))
+    normals = unit_rows(field.gradient(v))
     for _ in range(RELAX_ROUNDS):
         centroid = (adjacency @ v) / degree[:, None]
         step = centroid - v
         step -= np.einsum("ij,ij->i", step, normals)[:, None] * normals
         moved, _, g = project(field, v + RELAX_STEP * step, steps=2)
-        new_normals = _unit(g)
+        new_normals = unit_rows(g)
         bad_faces = _inverted_faces(moved, faces, new_normals) <= 0
         if bad_faces.any():
             undo = np.unique(faces[bad_faces])
@@ -206,4 +200,4 @@ def extract(field: BodyField, band: NarrowBand, length_scale: float) -> Extracti
     vertices, reverted = relax(field, vertices, faces)
     d, g = field.field(vertices)
     mesh = Mesh(vertices, faces.astype(np.int32))
-    return Extraction(mesh, _unit(g), float(np.max(np.abs(d))) if d.size else 0.0, unresolved, reverted)
+    return Extraction(mesh, unit_rows(g), float(np.max(np.abs(d))) if d.size else 0.0, unresolved, reverted)

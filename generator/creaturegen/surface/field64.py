@@ -77,16 +77,25 @@ class BodyField:
         return result
 
 
-def project(field: BodyField, points: F64, steps: int = 3) -> tuple[F64, F64, F64]:
-    """Newton steps ``p ← p − d∇d/|∇d|²`` onto the zero set; returns points, their d and ∇d.
+#: Squared gradient below which a point has no Newton direction and is left where it is.
+NEWTON_FLOOR = 1e-20
+FieldFn = Callable[[F64], tuple[F64, F64]]
 
-    Points whose gradient vanishes (|∇d|² ≤ 1e-20) are left where they are; callers gate on |d|.
-    """
-    p = points.copy()
-    d, g = field.field(p)
+
+def newton_project(fn: FieldFn, points: F64, steps: int) -> tuple[F64, F64, F64]:
+    """Newton steps ``p ← p − d∇d/|∇d|²`` onto the zero set of ``fn`` (points → (d, ∇d)); returns the
+    points with their final d and ∇d. Points with a vanishing gradient (a medial axis, a crease) stay put;
+    callers gate on |d|."""
+    p = np.array(points, dtype=np.float64, copy=True)
+    d, g = fn(p)
     for _ in range(steps):
         gg = np.einsum("ij,ij->i", g, g)
-        ok = gg > 1e-20
+        ok = gg > NEWTON_FLOOR
         p[ok] -= (d[ok] / gg[ok])[:, None] * g[ok]
-        d, g = field.field(p)
+        d, g = fn(p)
     return p, d, g
+
+
+def project(field: BodyField, points: F64, steps: int = 3) -> tuple[F64, F64, F64]:
+    """``newton_project`` on the body field, distance and gradient fused in one pass per step."""
+    return newton_project(field.field, points, steps)

@@ -38,6 +38,7 @@ import numpy.typing as npt
 
 from ..field import layout as col
 from ..rig import CompiledRig
+from .mesh import unit_rows
 from .skeleton import Skeleton
 
 F64 = npt.NDArray[np.float64]
@@ -50,17 +51,12 @@ CHORD_EPS = 1e-24
 ROOT_SPHERE_TANGENT = np.array([0.0, 0.0, 1.0])
 
 
-def _unit(v: F64) -> F64:
-    result: F64 = v / np.linalg.norm(v, axis=-1, keepdims=True)
-    return result
-
-
 def root_normal(t: F64) -> F64:
     """The one fixed rule, applied once per root at rest: the world axis least aligned with ``t``
     (the first on ties), Gram-Schmidt against ``t``."""
     axis = np.zeros(3)
     axis[int(np.argmin(np.abs(t)))] = 1.0
-    return _unit(axis - (axis @ t) * t)
+    return unit_rows(axis - (axis @ t) * t)
 
 
 def double_reflection(t0: F64, r0: F64, t1: F64, chord: F64) -> F64:
@@ -76,7 +72,7 @@ def double_reflection(t0: F64, r0: F64, t1: F64, chord: F64) -> F64:
     v2 = t1 - t_l
     c2 = float(v2 @ v2)
     r1 = r_l - (2.0 / c2) * float(v2 @ r_l) * v2 if c2 > CHORD_EPS else r_l
-    return _unit(r1 - (r1 @ t1) * t1)
+    return unit_rows(r1 - (r1 @ t1) * t1)
 
 
 def _matrix(t: F64, n: F64, origin: F64) -> F64:

@@ -36,8 +36,9 @@ import numpy.typing as npt
 from scipy.spatial import cKDTree
 
 from . import topology
+from .field64 import newton_project
 from .intersect import BVH, distances_to_mesh, point_triangle_distance, self_intersections, triangle_bvh
-from .mesh import Mesh
+from .mesh import Mesh, angles_deg
 
 F64 = npt.NDArray[np.float64]
 I64 = npt.NDArray[np.int64]
@@ -105,12 +106,6 @@ def _first(ids: npt.ArrayLike, limit: int = 5) -> str:
     return ", ".join(str(tuple(int(x) for x in row)) if np.ndim(row) else str(int(row)) for row in flat)
 
 
-def angles_deg(u: F64, v: F64) -> F64:
-    """Row-wise angle between vectors via atan2(|u×v|, u·v): accurate near 0° where acos is not."""
-    result: F64 = np.degrees(np.arctan2(np.linalg.norm(np.cross(u, v), axis=1), np.einsum("ij,ij->i", u, v)))
-    return result
-
-
 def vertex_normals(mesh: Mesh) -> F64:
     """Area-weighted: the unnormalised face normal is twice the area vector, so a plain sum weights it."""
     fn = mesh.face_normals()
@@ -123,19 +118,10 @@ def vertex_normals(mesh: Mesh) -> F64:
 def project_to_zero_set(
     points: F64, distance: DistanceFn, gradient: GradientFn, steps: int, tol: float
 ) -> tuple[F64, npt.NDArray[np.bool_]]:
-    """Newton steps p ← p − d∇d/|∇d|² in float64; returns the points and which ended with |d| < tol.
-
-    Points where the gradient vanishes (a medial axis, a blend crease) stay put and simply do not
-    converge; the gates measure only converged points, so a bad seed cannot fake a failure.
-    """
-    p = np.array(points, dtype=np.float64, copy=True)
-    for _ in range(steps):
-        d = distance(p)
-        g = gradient(p)
-        gg = np.einsum("ij,ij->i", g, g)
-        ok = gg > 1e-300
-        p[ok] -= (d[ok] / gg[ok])[:, None] * g[ok]
-    return p, np.abs(distance(p)) < tol
+    """Newton onto the zero set (field64.newton_project); returns the points and which ended with
+    |d| < tol. The gates measure only converged points, so a bad seed cannot fake a failure."""
+    p, d, _ = newton_project(lambda q: (distance(q), gradient(q)), points, steps)
+    return p, np.abs(d) < tol
 
 
 def surface_samples(mesh: Mesh, table: topology.EdgeTable) -> tuple[F64, I64]:

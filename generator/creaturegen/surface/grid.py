@@ -27,7 +27,7 @@ ERROR_TARGET = {"hero": 0.06, "repeated": 0.125, "distant": 0.25}
 MAX_CELLS_PER_AXIS = 640
 #: Fine cells per narrow-band block edge.
 BLOCK = 8
-#: Upper bound on |∇d| for every primitive form and blend (see ``lipschitz_bound``) with margin.
+#: Upper bound on |∇d| for every primitive form and blend (see ``LIPSCHITZ_BOUND``) with margin.
 LIPSCHITZ_MARGIN = 1.01
 
 
@@ -67,13 +67,10 @@ def spacing_for(slots: npt.NDArray[np.float64], tier: str) -> float:
     return math.sqrt(8.0 * ERROR_TARGET[tier]) * r_min
 
 
-def lipschitz_bound(slots: npt.NDArray[np.float64]) -> float:
-    """A bound on |∇d| over the body: √(1+s²) for tapered capsules, 1 for exact forms, kept by blends.
-
-    Polynomial smooth-min and log-sum-exp gradients are convex combinations of their children's, and a
-    hard min picks one, so no blend raises the bound.
-    """
-    return LIPSCHITZ_MARGIN * math.sqrt(1.0 + TAPER_EXACT_THRESHOLD**2)
+#: A bound on |∇d| over any body: √(1+s²) for tapered capsules (s ≤ TAPER_EXACT_THRESHOLD), 1 for exact
+#: forms. Polynomial smooth-min and log-sum-exp gradients are convex combinations of their children's, and
+#: a hard min picks one, so no blend raises it.
+LIPSCHITZ_BOUND = LIPSCHITZ_MARGIN * math.sqrt(1.0 + TAPER_EXACT_THRESHOLD**2)
 
 
 def swell_bound(graph: BlendGraph) -> float:

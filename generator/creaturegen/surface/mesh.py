@@ -44,3 +44,18 @@ class Mesh:
         f = self.faces
         result: npt.NDArray[np.int32] = np.stack([f, np.roll(f, -1, axis=1)], axis=2).reshape(-1, 2)
         return result
+
+
+def unit_rows(v: npt.NDArray[np.float64]) -> npt.NDArray[np.float64]:
+    """Rows scaled to unit length; zero rows stay zero (no direction to give them)."""
+    n = np.linalg.norm(v, axis=-1, keepdims=True)
+    result: npt.NDArray[np.float64] = v / np.where(n > 0, n, 1.0)
+    return result
+
+
+def angles_deg(u: npt.NDArray[np.float64], v: npt.NDArray[np.float64]) -> npt.NDArray[np.float64]:
+    """Row-wise angle between vectors via atan2(|u×v|, u·v): accurate near 0° where acos is not."""
+    result: npt.NDArray[np.float64] = np.degrees(
+        np.arctan2(np.linalg.norm(np.cross(u, v), axis=1), np.einsum("ij,ij->i", u, v))
+    )
+    return result

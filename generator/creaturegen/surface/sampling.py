@@ -1,7 +1,7 @@
 """Narrow-band sampling of the body field: a coarse pass over blocks, then fine nodes only near the surface.
 
 The lattice is cut into blocks of BLOCK³ cells. One coarse sample at each block centre certifies a whole
-block as inside or outside when ``|d| > λ·(half diagonal)`` (λ bounds |∇d|, grid.lipschitz_bound): the
+block as inside or outside when ``|d| > λ·(half diagonal)`` (λ bounds |∇d|, grid.LIPSCHITZ_BOUND): the
 field cannot reach zero within that distance. Only the remaining blocks, a shell around the surface, are
 sampled node by node; certified blocks take their centre's sign. The result is a sign lattice (int8) plus
 the float32 values at the evaluated nodes, which is what extraction needs.
@@ -21,7 +21,7 @@ import numpy.typing as npt
 from ..field.sampler import sample_distance
 from ..rig.graph import BlendGraph
 from .backends import FieldBackend
-from .grid import BLOCK, Grid, lipschitz_bound
+from .grid import BLOCK, LIPSCHITZ_BOUND, Grid
 
 #: Backend error bound used to decide which nodes are re-evaluated in float64, relative to L.
 SIGN_SETTLE_FACTOR = 1e-4
@@ -72,7 +72,7 @@ def sample_band(
     d_coarse = backend.distance(centres.astype(np.float32)).astype(np.float64)
     half_diagonal = 0.5 * BLOCK * grid.spacing * np.sqrt(3.0)
     delta = SIGN_SETTLE_FACTOR * length_scale
-    reach = lipschitz_bound(slots) * half_diagonal + delta
+    reach = LIPSCHITZ_BOUND * half_diagonal + delta
     active = np.flatnonzero(np.abs(d_coarse) <= reach)
 
     # Certified blocks: every node takes the centre's sign. Blocks overlap on faces; active blocks
