@@ -17,6 +17,7 @@ import numpy as np
 
 from . import __version__
 from .candidates import TIERS, describe_candidates
+from .creature.build import build_creature
 from .emit import PackageWriteError
 from .field.sampler import sample
 from .frost.build import build_frost
@@ -29,7 +30,6 @@ from .surface.asset import SurfaceCache
 from .surface.backends import BACKENDS
 from .surface.build import DEFAULT_TIER, SurfaceBuild, SurfaceRejectedError, build_surface
 from .surface.deform import DeformationError
-from .surface.emit import write_surface_package
 from .surface.grid import GridTooFineError
 
 EXIT_OK = 0
@@ -153,13 +153,13 @@ def _build_creature(args: argparse.Namespace, spec: CharacterSpec, data: bytes) 
     _print_gates(build)
     counts = build.sidecar["counts"]
     print(f"  mesh {counts}; " + ("cache hit" if build.cached else "extracted"))
+    print("==> package: candidate program tapes, sway pose, templates")
     try:
-        folder = write_surface_package(Path(args.out), spec.name, data, build)
+        folder = build_creature(spec, rig, data, build, Path(args.out))
     except PackageWriteError as exc:
         print(f"{args.spec}: cannot write the package: {exc}", file=sys.stderr)
         return EXIT_INVALID
-    print(f"wrote {folder}/ (assets/surface.glb, assets/surface.json, build-report.json)")
-    print("note: the creature runtime (core/, tsl/, index.js) is not emitted yet (issue 5)")
+    print(f"wrote {folder}/")
     return EXIT_OK
 
 

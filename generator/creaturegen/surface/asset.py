@@ -13,7 +13,10 @@ underscore; three.js's GLTFLoader lower-cases unknown names, so ``_SLOTS`` arriv
   float32 below 2²⁴);
 - ``_WEIGHTS`` FLOAT VEC4: their weights (non-negative, sum 1);
 - ``_CANDIDATE`` FLOAT SCALAR: the candidate program index (a whole number);
-- ``_RADIAL`` FLOAT VEC2: (θ around, t along) the dominant slot's axis.
+- ``_RADIAL`` FLOAT VEC2: (θ around, t along) the dominant slot's axis;
+- ``_SKIN`` FLOAT VEC2: the vertex's skinning method (0 LBS, 1 DQ, 2 CoR: its joint's choice) and its
+  correction trust radius in metres, 0 outside the correction region (the region policy, baked);
+- ``_COR`` FLOAT VEC3: the vertex's centre of rotation (used only where the method is CoR, else 0).
 
 Indices are UNSIGNED_SHORT when every index fits below 65535 (the value glTF reserves for primitive
 restart), UNSIGNED_INT otherwise. Per-slot rest frames are one more accessor (FLOAT MAT4, count S)
@@ -143,6 +146,8 @@ class SurfaceAsset:
     radial: F32  # (V, 2), (θ around, t along) the dominant slot's axis
     rest_frames: F32  # (S, 4, 4), column-major
     extras: dict[str, object] = field(default_factory=dict)
+    skin: F32 | None = None  # (V, 2): method code (0 lbs, 1 dq, 2 cor), trust radius (0: no correction)
+    cor_centers: F32 | None = None  # (V, 3): CoR centre where the method is CoR, else 0
 
     def __post_init__(self) -> None:
         positions = _frozen(self.positions, "<f4", (None, 3), "positions")
@@ -157,6 +162,9 @@ class SurfaceAsset:
         radial = _frozen(self.radial, "<f4", (v, 2), "radial")
         rest_frames = _frozen(self.rest_frames, "<f4", (None, 4, 4), "rest_frames")
         extras = _json_clean(self.extras, "extras")
+        skin = _frozen(np.zeros((v, 2)) if self.skin is None else self.skin, "<f4", (v, 2), "skin")
+        cor = np.zeros((v, 3)) if self.cor_centers is None else self.cor_centers
+        cor_centers = _frozen(cor, "<f4", (v, 3), "cor_centers")
 
         if indices.size == 0 or indices.size % 3:
             raise ValueError(f"indices: {indices.size} is not a positive multiple of 3")
@@ -175,6 +183,8 @@ class SurfaceAsset:
             raise ValueError("slots: slot index out of range of rest_frames")
         if REST_FRAMES_KEY in extras:
             raise ValueError(f"extras: {REST_FRAMES_KEY!r} is reserved")
+        if not np.all(np.isin(skin[:, 0], (0.0, 1.0, 2.0))) or np.any(skin[:, 1] < 0):
+            raise ValueError("skin: method codes must be 0, 1 or 2 and trust radii non-negative")
 
         for name, value in (
             ("positions", positions),
@@ -186,6 +196,8 @@ class SurfaceAsset:
             ("radial", radial),
             ("rest_frames", rest_frames),
             ("extras", extras),
+            ("skin", skin),
+            ("cor_centers", cor_centers),
         ):
             object.__setattr__(self, name, value)
 
@@ -200,7 +212,18 @@ class SurfaceAsset:
     def __eq__(self, other: object) -> bool:
         if not isinstance(other, SurfaceAsset):
             return NotImplemented
-        arrays = ("positions", "normals", "indices", "slots", "weights", "candidate", "radial", "rest_frames")
+        arrays = (
+            "positions",
+            "normals",
+            "indices",
+            "slots",
+            "weights",
+            "candidate",
+            "radial",
+            "rest_frames",
+            "skin",
+            "cor_centers",
+        )
         return self.extras == other.extras and all(
             getattr(self, a).dtype == getattr(other, a).dtype
             and np.array_equal(getattr(self, a), getattr(other, a))
@@ -274,6 +297,8 @@ def glb_bytes(asset: SurfaceAsset, *, name: str) -> bytes:
         "_WEIGHTS": b.add(asset.weights, FLOAT, "VEC4", target=ARRAY_BUFFER),
         "_CANDIDATE": b.add(asset.candidate.astype(np.float32), FLOAT, "SCALAR", target=ARRAY_BUFFER),
         "_RADIAL": b.add(asset.radial, FLOAT, "VEC2", target=ARRAY_BUFFER),
+        "_SKIN": b.add(asset.skin, FLOAT, "VEC2", target=ARRAY_BUFFER),
+        "_COR": b.add(asset.cor_centers, FLOAT, "VEC3", target=ARRAY_BUFFER),
     }
     index_type = UNSIGNED_SHORT if asset.vertex_count <= MAX_UINT16_VERTICES else UNSIGNED_INT
     indices = b.add(asset.indices, index_type, "SCALAR", target=ELEMENT_ARRAY_BUFFER)
@@ -414,6 +439,8 @@ def parse_glb(data: bytes) -> SurfaceAsset:
             radial=_read_accessor(document, binary, attributes["_RADIAL"], "VEC2"),
             rest_frames=_read_accessor(document, binary, rest_index, "MAT4").reshape(-1, 4, 4),
             extras=document["asset"].get("extras", node_extras),
+            skin=_read_accessor(document, binary, attributes["_SKIN"], "VEC2"),
+            cor_centers=_read_accessor(document, binary, attributes["_COR"], "VEC3"),
         )
     except GlbFormatError:
         raise

@@ -176,13 +176,13 @@ def correction_sweep(
     skeleton: Skeleton,
     choice: deform.DeformationChoice,
     programs: npt.NDArray[np.int64],
-) -> tuple[npt.NDArray[np.bool_], CorrectionReport, float]:
+) -> tuple[npt.NDArray[np.bool_], CorrectionReport, float, F64]:
     """Region policy and correction over the sweep's extreme poses, measured on each joint's seam.
 
     The region is every seam vertex whose skinned position misses the posed field by more than
     SKIN_ERROR_FACTOR·L in some pose of its joint; each pose is then corrected over the region's seam
     vertices that have a candidate program (the caller gates those that have none) and the worst report
-    kept. Returns (region, worst report, worst skin-only seam error in m).
+    kept. Returns (region, worst report, worst skin-only seam error in m, per-vertex trust radius).
     """
     owner = weights[0][:, 0]
     radius = np.maximum(rig.slots[owner, col.RA], rig.slots[owner, col.RB])
@@ -219,7 +219,26 @@ def correction_sweep(
             worst = report
     if worst is None:
         worst = CorrectionReport(0, 0, 0.0, 0.0, 0.0, 0, 0, 0, 0, 0, 0)
-    return region, worst, worst_skin
+    return region, worst, worst_skin, trust
+
+
+def runtime_skin(
+    indices: npt.NDArray[np.int32],
+    weights: F64,
+    choice: deform.DeformationChoice,
+    skeleton: Skeleton,
+    region: npt.NDArray[np.bool_],
+    programs: npt.NDArray[np.int64],
+    trust: F64,
+) -> npt.NDArray[np.float32]:
+    """(V, 2) what the runtime needs per vertex: its skinning method code and its correction trust radius.
+
+    The trust radius is zero outside the region policy's vertices (and where no candidate program covers
+    a vertex), so the runtime corrects exactly the vertices the build proved need it.
+    """
+    method = deform.vertex_methods(indices, weights, choice.methods, skeleton).astype(np.float64)
+    radius = np.where(region & (programs != NO_PROGRAM), trust, 0.0)
+    return np.stack([method, radius], axis=1).astype(np.float32)
 
 
 def _fail_on(gates: list[SurfaceGate], where: str) -> None:
@@ -411,7 +430,7 @@ def build_surface(
 
     t = time.perf_counter()
     programs, candidate_note = candidate_index(spec, rig, tier, mesh.vertices)
-    region, report, worst_skin = correction_sweep(
+    region, report, worst_skin, trust = correction_sweep(
         rig, mesh, ex.normals, (weights.indices, weights.weights), skeleton, choice, programs
     )
     timings["correction"] = time.perf_counter() - t
@@ -471,6 +490,12 @@ def build_surface(
         candidate=programs.astype(np.uint16),
         radial=radial.astype(np.float32),
         rest_frames=np.transpose(frames, (0, 2, 1)).astype(np.float32),
+        skin=runtime_skin(weights.indices, weights.weights, choice, skeleton, region, programs, trust),
+        cor_centers=np.where(
+            (deform.vertex_methods(weights.indices, weights.weights, choice.methods, skeleton) == 2)[:, None],
+            choice.centers,
+            0.0,
+        ).astype(np.float32),
         extras={"creaturegen": __version__, "tier": tier, **signatures},
     )
     sidecar: dict[str, object] = {

@@ -1,0 +1,55 @@
+"""Build a creature package: plan → templates + assets + build-report.json → out/<slug>/ (atomically)."""
+
+from __future__ import annotations
+
+import hashlib
+from pathlib import Path
+from typing import Any
+
+from ..emit.render import render_folder, to_json
+from ..emit.writer import PackageFile, header_text, write_package
+from ..rig import CompiledRig
+from ..spec import CharacterSpec, slugify
+from ..surface.asset import glb_bytes, sidecar_bytes
+from ..surface.build import SurfaceBuild
+from ..surface.emit import stable_sidecar
+from .plan import build_plan
+
+
+def build_report(plan: dict[str, Any], surface: SurfaceBuild) -> dict[str, Any]:
+    return {
+        "//": header_text(str(plan["specSha256"])),
+        "kind": "creature",
+        "name": plan["name"],
+        "package": plan["slug"],
+        "compilerVersion": plan["version"],
+        "specSha256": plan["specSha256"],
+        "signatures": plan["signatures"],
+        "tier": plan["tier"],
+        "workload": plan["workload"],
+        "methods": plan["methods"],
+        "debugModes": plan["runtime"]["debugModes"],
+        "candidateNote": plan["runtime"]["candidateNote"],
+        "surface": {"passed": surface.passed, "counts": surface.sidecar.get("counts")},
+        "gates": plan["gates"],
+    }
+
+
+def creature_files(
+    spec: CharacterSpec, rig: CompiledRig, spec_bytes: bytes, surface: SurfaceBuild
+) -> list[PackageFile]:
+    spec_sha256 = hashlib.sha256(spec_bytes).hexdigest()
+    built = build_plan(spec, rig, surface, spec_sha256)
+    plan = built.plan
+    files = render_folder("creature", plan, spec_sha256)
+    files.append(PackageFile("assets/surface.glb", glb_bytes(surface.asset, name=str(plan["slug"]))))
+    files.append(PackageFile("assets/surface.json", sidecar_bytes(stable_sidecar(surface.sidecar))))
+    files.append(PackageFile("build-report.json", (to_json(build_report(plan, surface)) + "\n").encode()))
+    return files
+
+
+def build_creature(
+    spec: CharacterSpec, rig: CompiledRig, spec_bytes: bytes, surface: SurfaceBuild, out_root: Path
+) -> Path:
+    """Write the package and return its folder. Nothing is written if any step raises."""
+    return write_package(out_root, slugify(spec.name), creature_files(spec, rig, spec_bytes, surface))

@@ -1,0 +1,139 @@
+"""The creature build plan: every number the package's runtime needs, computed once, as plain JSON data.
+
+Templates print this plan and nothing else. ``plan["runtime"]`` becomes core/data.js; the Python
+reference (creature/sway.py, creature/reference.py) reads the same rig, skeleton and tapes, which is what
+makes the lab-vs-numpy parity job meaningful.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from .. import __version__
+from ..candidates import TierRejectedError, build_candidates
+from ..field.floors import floors_for
+from ..field.primitives import GRADIENT_FLOOR, slot_uses_round_cone
+from ..rig import CompiledRig
+from ..spec import CharacterSpec, slugify
+from ..surface import correct as correction
+from ..surface.build import NO_PROGRAM, SurfaceBuild
+from ..surface.deform import METHODS
+from ..surface.skeleton import Skeleton, build_skeleton
+from . import sway as sway_module
+from .tape import Tape, compile_tape
+
+#: The runtime's debug views (lab `setDebugMode`); "shell" is the diagnostic capsule shell.
+DEBUG_MODES = ("off", "skin-only", "distance", "weights", "normals", "candidates", "shell")
+
+
+@dataclass(frozen=True)
+class CreaturePlan:
+    plan: dict[str, Any]
+    tapes: tuple[Tape, ...]  # candidate programs in asset order, then the full graph
+    skeleton: Skeleton
+    sway: sway_module.Sway
+
+
+def program_tapes(spec: CharacterSpec, rig: CompiledRig, tier: str) -> tuple[list[Tape], str]:
+    """Tapes of the tier's candidate programs (the asset's ``_CANDIDATE`` indexes them) + the full graph."""
+    try:
+        found = build_candidates(spec, rig, tier)
+        tapes = [compile_tape(p.graph, p.leaves) for p in found.programs]
+        note = ""
+    except TierRejectedError as exc:
+        tapes, note = [], str(exc)
+    tapes.append(compile_tape(rig.graph))
+    return tapes, note
+
+
+def program_data(tapes: list[Tape]) -> list[float]:
+    """Headers (offset, count, 0, 0) per program, then every instruction (op, a, b, k), flat."""
+    headers: list[float] = []
+    body: list[float] = []
+    offset = len(tapes)
+    for tape in tapes:
+        headers += [float(offset), float(len(tape)), 0.0, 0.0]
+        for op, a, b, k in tape.instructions:
+            body += [float(op), float(a), float(b), float(k)]
+        offset += len(tape)
+    return headers + body
+
+
+def build_plan(
+    spec: CharacterSpec, rig: CompiledRig, surface: SurfaceBuild, spec_sha256: str
+) -> CreaturePlan:
+    skeleton = build_skeleton(spec, rig)
+    sway = sway_module.build_sway(rig, skeleton)
+    tapes, note = program_tapes(spec, rig, surface.tier)
+    floors = floors_for(rig.body_scale)
+    asset = surface.asset
+    skin = np.asarray(asset.skin)  # (V, 2): method code, trust radius
+    runtime: dict[str, Any] = {
+        "name": spec.name,
+        "slug": slugify(spec.name),
+        "version": __version__,
+        "specSha256": spec_sha256,
+        "signatures": dict(surface.signatures),
+        "tier": surface.tier,
+        "bodyScale": rig.body_scale,
+        "slotCount": rig.slot_count,
+        # One extra "part" per instance: the root transform rows (position + alive, yaw cos/sin).
+        "maxParts": rig.slot_count + 1,
+        "poseRows": sway_module.POSE_ROWS,
+        "slots": rig.slots.tolist(),
+        "slotNames": list(skeleton.names),
+        "roundCone": [int(x) for x in slot_uses_round_cone(rig.slots)],
+        "sway": {
+            "parent": list(sway.parent),
+            "order": list(sway.order),
+            "pivot": sway.pivot.tolist(),
+            "axis": sway.axis.tolist(),
+            "phase": sway.phase.tolist(),
+            "amplitude": sway.amplitude,
+            "period": sway.period,
+        },
+        "lcg": {"a": sway_module.LCG_A, "c": sway_module.LCG_C},
+        "tickRate": 60,
+        "programData": program_data(tapes),
+        "programCount": len(tapes),
+        "fullProgram": len(tapes) - 1,
+        "noProgram": NO_PROGRAM,
+        "registers": max(len(t) for t in tapes),
+        "candidateNote": note,
+        "gradientFloor": GRADIENT_FLOOR,
+        "tiny": float(np.finfo(np.float32).tiny),
+        "kFloor": floors.k_floor,
+        "correction": {
+            "budget": correction.DEFAULT_BUDGET,
+            "earlyOut": correction.EARLY_OUT,
+            "gradientFloor": correction.GRADIENT_FLOOR,
+        },
+        "mesh": {"vertices": asset.vertex_count, "triangles": int(asset.indices.size // 3)},
+        "debugModes": list(DEBUG_MODES),
+    }
+    corrected = int(np.count_nonzero(skin[:, 1] > 0))
+    plan: dict[str, Any] = {
+        "name": spec.name,
+        "slug": runtime["slug"],
+        "version": __version__,
+        "specSha256": spec_sha256,
+        "runtime": runtime,
+        "signatures": dict(surface.signatures),
+        "tier": surface.tier,
+        "gates": [g.as_dict() for g in surface.gates],
+        "workload": {
+            "tier": surface.tier,
+            "slots": rig.slot_count,
+            "K": runtime["registers"],
+            "programs": len(tapes),
+            "vertices": asset.vertex_count,
+            "triangles": runtime["mesh"]["triangles"],
+            "correctedVertices": corrected,
+            "poseBytesPerBody": runtime["maxParts"] * sway_module.POSE_ROWS * 16,
+        },
+        "methods": {m: int(np.count_nonzero(skin[:, 0] == i)) for i, m in enumerate(METHODS)},
+    }
+    return CreaturePlan(plan, tuple(tapes), skeleton, sway)

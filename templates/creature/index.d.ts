@@ -1,0 +1,76 @@
+import type { Camera, Group, Mesh, Object3D, WebGPURenderer } from 'three/webgpu';
+
+export type DebugMode = 'off' | 'skin-only' | 'distance' | 'weights' | 'normals' | 'candidates' | 'shell';
+export type TierName = 'hero' | 'repeated' | 'distant';
+
+export interface PopulationOptions {
+  /** Bodies the population can hold; every page is allocated up front (default 64). */
+  capacity?: number;
+  /** Bodies per page: one material and one draw call each (default 64). */
+  pageSize?: number;
+  /** Must be the tier the package was built for. */
+  tier?: TierName;
+  debugMode?: DebugMode;
+  /** Where to fetch assets/surface.glb from (default: next to this module). */
+  surfaceUrl?: string;
+}
+
+export interface SpawnOptions {
+  /** Unsigned 32-bit seed: the sway phase offset and yaw come from the package's LCG. */
+  seed?: number;
+  position?: [number, number, number];
+}
+
+export interface InstanceInfo {
+  alive: boolean;
+  seed: number;
+  tickOffset: number;
+  yaw: number;
+  position: [number, number, number];
+  /** Posed world AABB: min xyz, max xyz. */
+  bounds: number[];
+}
+
+export interface CreaturePopulation {
+  readonly object3d: Group;
+  readonly tick: number;
+  readonly capacity: number;
+  readonly count: number;
+  readonly debugMode: DebugMode;
+  readonly stats: { uploads: number; uploadBytes: number; lastFrameBytes: number; spawns: number; ticks: number };
+  readonly pages: { mesh: Mesh }[];
+  /** Validation plus an O(slots) write; returns the instance id. Throws when full. */
+  spawn(options?: SpawnOptions): number;
+  despawn(id: number): void;
+  /** Advance n fixed ticks; returns the bytes uploaded. */
+  stepTicks(n?: number): number;
+  /** Jump to tick n; returns the bytes uploaded. */
+  seekTick(n: number): number;
+  /** Upload the dirty pose ranges left by spawn/despawn. */
+  flush(): number;
+  instance(id: number): InstanceInfo;
+  stagedPose(id: number): Float32Array;
+  stateHash(): string;
+  setDebugMode(mode: DebugMode): void;
+  setTier(tier: TierName): void;
+  variantKeys(): string[];
+  /** compileAsync every shipped variant (display and shadow) before the first visible frame. */
+  warm(scene: Object3D, camera: Camera): Promise<void>;
+  dispose(): void;
+}
+
+export interface CreatureDiagnostics {
+  readSkinned(id: number): Promise<{ skinned: Float32Array; corrected: Float32Array; accepted: Float32Array; gradient: Float32Array; distance: Float32Array }>;
+  probeField(id: number, xyz: Float32Array, program?: number): Promise<Float32Array>;
+  readPose(id: number): Promise<Float32Array>;
+}
+
+export const CREATURE: Readonly<Record<string, unknown>>;
+export const DEBUG_MODES: readonly DebugMode[];
+/** Requires an initialised WebGPURenderer on a WebGPU backend; throws otherwise. */
+export function createCreaturePopulation(renderer: WebGPURenderer, options?: PopulationOptions): Promise<CreaturePopulation>;
+export function createDiagnostics(renderer: WebGPURenderer, population: CreaturePopulation, options?: { maxPoints?: number }): CreatureDiagnostics;
+export function hashBytes(bytes: Uint8Array, tick: number): string;
+export function instanceOffset(seed: number, lcg: { a: number; c: number }, period: number): { tickOffset: number; yaw: number };
+export function lcgNext(state: number, a: number, c: number): number;
+export function parseGlb(buffer: ArrayBuffer): { attributes: Record<string, { array: Float32Array | Uint16Array | Uint32Array; itemSize: number }>; index: { array: Uint16Array | Uint32Array }; extras: Record<string, unknown> };

@@ -1,0 +1,115 @@
+// Diagnostics for the lab and the parity job: compute kernels that call the very same TSL functions as
+// the material (field programs, skinning, correction), with results read back from the GPU. Kernels and
+// their buffers are created on first use, never by spawn or render.
+import { Fn, instanceIndex, instancedArray, int, uniform, vec4 } from 'three/tsl';
+import { bodyFunctions, bodyVertex } from './material.js';
+
+function vec4Array(source, itemSize, count) {
+  const out = new Float32Array(4 * count);
+  for (let i = 0; i < count; i++) for (let c = 0; c < itemSize; c++) out[4 * i + c] = source[itemSize * i + c];
+  return out;
+}
+
+export function createDiagnostics(renderer, population, { maxPoints = 8192 } = {}) {
+  const { layout, programs, geometry, pages } = population;
+  const n = geometry.attributes.position.count;
+  const rowsPerInstance = layout.maxParts * layout.rows;
+  let skinState = null;
+  let probeState = null;
+
+  function skinKernels() {
+    if (skinState) return skinState;
+    const a = geometry.attributes;
+    const vA = instancedArray(vec4Array(a.position.array, 3, n), 'vec4').toReadOnly();
+    const vB = instancedArray(new Float32Array(a.cgSlots.array), 'vec4').toReadOnly();
+    const vC = instancedArray(new Float32Array(a.cgWeights.array), 'vec4').toReadOnly();
+    const vD = instancedArray(vec4Array(a.cgCor.array, 3, n), 'vec4').toReadOnly();
+    const vM = instancedArray(new Float32Array(a.cgSkin.array), 'vec4').toReadOnly();
+    const out = instancedArray(3 * n, 'vec4');
+    const instance = uniform(0, 'int');
+    const kernels = pages.map((page) => {
+      const fns = bodyFunctions(layout, page.pose, programs);
+      return Fn(() => {
+        const i = int(instanceIndex);
+        const base = instance.mul(rowsPerInstance).toVar();
+        const body = bodyVertex(layout, fns, {
+          rest: vA.element(i).xyz, slots: vB.element(i), weights: vC.element(i), skin: vM.element(i),
+          cor: vD.element(i).xyz, base, skinOnly: false,
+        });
+        out.element(i.mul(3)).assign(vec4(body.skinned, 0));
+        out.element(i.mul(3).add(1)).assign(vec4(body.position, body.accepted));
+        out.element(i.mul(3).add(2)).assign(vec4(body.gradient, body.distance));
+      })().compute(n);
+    });
+    skinState = { out, instance, kernels };
+    return skinState;
+  }
+
+  function probeKernels() {
+    if (probeState) return probeState;
+    const points = instancedArray(new Float32Array(4 * maxPoints), 'vec4');
+    const out = instancedArray(maxPoints, 'vec4');
+    const instance = uniform(0, 'int');
+    const program = uniform(layout.fullProgram, 'int');
+    const count = uniform(0, 'int');
+    const kernels = pages.map((page) => {
+      const fns = bodyFunctions(layout, page.pose, programs);
+      return Fn(() => {
+        const i = int(instanceIndex);
+        const base = instance.mul(rowsPerInstance).toVar();
+        out.element(i).assign(fns.field.runProgram(points.element(i).xyz, base, program));
+      })().compute(maxPoints);
+    });
+    probeState = { points, out, instance, program, count, kernels };
+    return probeState;
+  }
+
+  return {
+    /**
+     * Skinned, corrected and gradient data of instance `id` (creature-local, before the root
+     * transform): { skinned, corrected, accepted, gradient, distance } as Float32Arrays.
+     */
+    async readSkinned(id) {
+      const { page, index } = population.locate(id);
+      const s = skinKernels();
+      s.instance.value = index;
+      renderer.compute(s.kernels[pages.indexOf(page)]);
+      const raw = new Float32Array(await renderer.getArrayBufferAsync(s.out.value));
+      const skinned = new Float32Array(3 * n), corrected = new Float32Array(3 * n), gradient = new Float32Array(3 * n);
+      const accepted = new Float32Array(n), distance = new Float32Array(n);
+      for (let v = 0; v < n; v++) {
+        for (let c = 0; c < 3; c++) {
+          skinned[3 * v + c] = raw[12 * v + c];
+          corrected[3 * v + c] = raw[12 * v + 4 + c];
+          gradient[3 * v + c] = raw[12 * v + 8 + c];
+        }
+        accepted[v] = raw[12 * v + 7];
+        distance[v] = raw[12 * v + 11];
+      }
+      return { skinned, corrected, accepted, gradient, distance };
+    },
+    /** The body field of instance `id` at creature-local points (Float32Array xyz): vec4 (d, ∇d) each. */
+    async probeField(id, xyz, program = layout.fullProgram) {
+      const count = xyz.length / 3;
+      if (count > maxPoints) throw new Error(`probeField: at most ${maxPoints} points per call (got ${count})`);
+      const { page, index } = population.locate(id);
+      const s = probeKernels();
+      const arr = s.points.value.array;
+      arr.fill(0);
+      for (let i = 0; i < count; i++) { arr[4 * i] = xyz[3 * i]; arr[4 * i + 1] = xyz[3 * i + 1]; arr[4 * i + 2] = xyz[3 * i + 2]; }
+      s.points.value.needsUpdate = true;
+      s.instance.value = index;
+      s.program.value = program;
+      renderer.compute(s.kernels[pages.indexOf(page)]);
+      const raw = new Float32Array(await renderer.getArrayBufferAsync(s.out.value));
+      return raw.slice(0, 4 * count);
+    },
+    /** The pose rows of instance `id` as the GPU holds them (readback). */
+    async readPose(id) {
+      const { page, index } = population.locate(id);
+      const floats = rowsPerInstance * 4;
+      const buffer = await renderer.getArrayBufferAsync(page.pose.value, null, 4 * floats * index, 4 * floats);
+      return new Float32Array(buffer);
+    },
+  };
+}

@@ -1,0 +1,291 @@
+// A population of one creature: fixed-capacity pose pages (vec4 storage, CPU Float32Array staging),
+// one material and one draw per page, coalesced dirty-range uploads, posed bounds per page, spawn as
+// validation plus an O(slots) write. Nothing is created after `ready` resolves: pages, materials and
+// pipelines are built and compileAsync-warmed up front.
+import * as THREE from 'three/webgpu';
+import { instancedArray } from 'three/tsl';
+import { CREATURE } from '../core/data.js';
+import { parseGlb } from '../core/glb.js';
+import { hashBytes } from '../core/hash.js';
+import { instanceOffset } from '../core/lcg.js';
+import { createPoseScratch, swayTransforms, writePoseRows } from '../core/pose.js';
+import { DEBUG_MODES, createBodyMaterial, layoutOf } from './material.js';
+
+const SHIPPED_VARIANTS = ['off'];
+
+/** Throw unless `renderer` is an initialised WebGPURenderer on the WebGPU backend. */
+export function assertWebGPU(renderer) {
+  if (!renderer || !renderer.backend || renderer.backend.isWebGPUBackend !== true) {
+    throw new Error(`${CREATURE.slug}: needs WebGPURenderer on a WebGPU backend (await renderer.init() first; `
+      + 'the WebGL2 fallback is not supported)');
+  }
+}
+
+/** BufferGeometry of the reference mesh with the skinning attributes this package's material reads. */
+export function surfaceGeometry(surface) {
+  const a = surface.attributes;
+  const geometry = new THREE.BufferGeometry();
+  geometry.setAttribute('position', new THREE.BufferAttribute(a.POSITION.array, 3));
+  geometry.setAttribute('normal', new THREE.BufferAttribute(a.NORMAL.array, 3));
+  geometry.setAttribute('cgSlots', new THREE.BufferAttribute(a._SLOTS.array, 4));
+  geometry.setAttribute('cgWeights', new THREE.BufferAttribute(a._WEIGHTS.array, 4));
+  geometry.setAttribute('cgCor', new THREE.BufferAttribute(a._COR.array, 3));
+  const n = a.POSITION.array.length / 3;
+  const skin = new Float32Array(4 * n);
+  for (let i = 0; i < n; i++) {
+    skin[4 * i] = a._SKIN.array[2 * i];
+    skin[4 * i + 1] = a._SKIN.array[2 * i + 1];
+    skin[4 * i + 2] = a._CANDIDATE.array[i];
+  }
+  geometry.setAttribute('cgSkin', new THREE.BufferAttribute(skin, 4));
+  geometry.setIndex(new THREE.BufferAttribute(surface.index.array, 1));
+  return geometry;
+}
+
+/** The program tape as a vec4 storage node (headers, then instructions), shared by every page. */
+export function programStorage(data) {
+  return instancedArray(new Float32Array(data.programData), 'vec4').toReadOnly();
+}
+
+async function loadSurface(url) {
+  const response = await fetch(url);
+  if (!response.ok) throw new Error(`${CREATURE.slug}: cannot load ${url} (${response.status})`);
+  return parseGlb(await response.arrayBuffer());
+}
+
+/**
+ * Create a population. Options: capacity (bodies, default 64), pageSize (bodies per page and draw,
+ * default 64), tier (the built tier only), debugMode, surfaceUrl (default: this package's asset).
+ */
+export async function createCreaturePopulation(renderer, options = {}) {
+  assertWebGPU(renderer);
+  const data = CREATURE;
+  const capacity = options.capacity ?? 64;
+  const pageSize = Math.min(options.pageSize ?? 64, capacity);
+  if (!Number.isInteger(capacity) || capacity < 1) throw new Error(`capacity: must be a positive integer (got ${capacity})`);
+  if (!Number.isInteger(pageSize) || pageSize < 1) throw new Error(`pageSize: must be a positive integer (got ${pageSize})`);
+  const tier = options.tier ?? data.tier;
+  if (tier !== data.tier) throw new Error(`tier: this package was built for tier ${data.tier} (got ${tier}); rebuild with --tier ${tier}`);
+  const surface = await loadSurface(options.surfaceUrl ?? new URL('../assets/surface.glb', import.meta.url).href);
+  const geometry = surfaceGeometry(surface);
+  const layout = layoutOf(data);
+  const programs = programStorage(data);
+  const floatsPerInstance = data.maxParts * data.poseRows * 4;
+  const group = new THREE.Group();
+  group.name = data.slug;
+  const variants = new Map();
+  const stats = { uploads: 0, uploadBytes: 0, lastFrameBytes: 0, spawns: 0, ticks: 0 };
+
+  const pages = [];
+  for (let first = 0; first < capacity; first += pageSize) {
+    const size = Math.min(pageSize, capacity - first);
+    const pose = instancedArray(new Float32Array(size * floatsPerInstance), 'vec4');
+    const mesh = new THREE.Mesh(geometry, null);
+    mesh.count = 0;
+    mesh.castShadow = true;
+    mesh.receiveShadow = true;
+    mesh.boundingSphere = new THREE.Sphere(new THREE.Vector3(), 0);
+    mesh.name = `${data.slug}.page${pages.length}`;
+    group.add(mesh);
+    pages.push({
+      first, size, pose, mesh, staging: pose.value.array,
+      alive: new Uint8Array(size), seed: new Uint32Array(size), tickOffset: new Int32Array(size),
+      yaw: new Float64Array(size), position: new Float64Array(3 * size), bounds: new Float64Array(6 * size),
+      dirtyLo: Infinity, dirtyHi: -1,
+    });
+  }
+  const scratch = createPoseScratch(data.slotCount);
+  const boxScratch = new Float64Array(6);
+  const sphere = new THREE.Sphere();
+  const box = new THREE.Box3();
+  let tick = 0;
+  let mode = options.debugMode ?? 'off';
+
+  const variantKey = (m) => [data.signatures.compilerSignature, data.signatures.topologySignature, data.tier, m, data.registers].join('|');
+  function materialFor(page, m) {
+    if (!DEBUG_MODES.includes(m)) throw new Error(`debugMode: one of ${DEBUG_MODES.join(', ')} (got ${m})`);
+    if (m === 'shell') throw new Error('debugMode shell: the diagnostic capsule shell is not part of this package yet');
+    const key = `${variantKey(m)}|page${pages.indexOf(page)}`;
+    if (!variants.has(key)) variants.set(key, createBodyMaterial(layout, page.pose, programs, m));
+    return variants.get(key);
+  }
+  for (const page of pages) page.mesh.material = materialFor(page, mode);
+
+  function writeInstance(page, j) {
+    const base = j * floatsPerInstance;
+    swayTransforms(data, tick + page.tickOffset[j], scratch);
+    writePoseRows(data, scratch, page.staging, base, boxScratch);
+    const root = base + data.slotCount * data.poseRows * 4;
+    const c = Math.cos(page.yaw[j]), s = Math.sin(page.yaw[j]);
+    page.staging[root] = page.position[3 * j];
+    page.staging[root + 1] = page.position[3 * j + 1];
+    page.staging[root + 2] = page.position[3 * j + 2];
+    page.staging[root + 3] = page.alive[j];
+    page.staging[root + 4] = c;
+    page.staging[root + 5] = s;
+    page.staging[root + 6] = 0;
+    page.staging[root + 7] = 0;
+    // Posed AABB of the primitives, rotated by the yaw (conservatively) and moved: the instance bounds.
+    const cx = 0.5 * (boxScratch[0] + boxScratch[3]), cz = 0.5 * (boxScratch[2] + boxScratch[5]);
+    const hx = 0.5 * (boxScratch[3] - boxScratch[0]), hz = 0.5 * (boxScratch[5] - boxScratch[2]);
+    const wx = Math.abs(c) * hx + Math.abs(s) * hz, wz = Math.abs(s) * hx + Math.abs(c) * hz;
+    const px = c * cx + s * cz + page.position[3 * j], pz = -s * cx + c * cz + page.position[3 * j + 2];
+    const b = page.bounds;
+    b[6 * j] = px - wx; b[6 * j + 1] = boxScratch[1] + page.position[3 * j + 1]; b[6 * j + 2] = pz - wz;
+    b[6 * j + 3] = px + wx; b[6 * j + 4] = boxScratch[4] + page.position[3 * j + 1]; b[6 * j + 5] = pz + wz;
+    page.dirtyLo = Math.min(page.dirtyLo, j);
+    page.dirtyHi = Math.max(page.dirtyHi, j);
+  }
+
+  function refreshBounds(page) {
+    box.makeEmpty();
+    let last = -1;
+    for (let j = 0; j < page.size; j++) {
+      if (!page.alive[j]) continue;
+      last = j;
+      const b = page.bounds;
+      box.expandByPoint(sphere.center.set(b[6 * j], b[6 * j + 1], b[6 * j + 2]));
+      box.expandByPoint(sphere.center.set(b[6 * j + 3], b[6 * j + 4], b[6 * j + 5]));
+    }
+    page.mesh.count = last + 1;
+    if (last < 0) page.mesh.boundingSphere.set(page.mesh.boundingSphere.center.set(0, 0, 0), 0);
+    else box.getBoundingSphere(page.mesh.boundingSphere);
+  }
+
+  // One coalesced range per page: [first dirty instance, last dirty instance], uploaded once per flush.
+  function flush() {
+    let bytes = 0;
+    for (const page of pages) {
+      if (page.dirtyHi < 0) continue;
+      const start = page.dirtyLo * floatsPerInstance;
+      const count = (page.dirtyHi - page.dirtyLo + 1) * floatsPerInstance;
+      page.pose.value.addUpdateRange(start, count);
+      page.pose.value.needsUpdate = true;
+      bytes += 4 * count;
+      page.dirtyLo = Infinity;
+      page.dirtyHi = -1;
+      refreshBounds(page);
+    }
+    stats.lastFrameBytes = bytes;
+    stats.uploadBytes += bytes;
+    if (bytes) stats.uploads += 1;
+    return bytes;
+  }
+
+  function locate(id) {
+    if (!Number.isInteger(id) || id < 0 || id >= capacity) throw new Error(`id: ${id} is not an instance of this population (0..${capacity - 1})`);
+    const page = pages[Math.floor(id / pageSize)];
+    return { page, j: id - page.first };
+  }
+
+  function setTick(n) {
+    tick = n;
+    for (const page of pages) for (let j = 0; j < page.size; j++) if (page.alive[j]) writeInstance(page, j);
+  }
+
+  const population = {
+    object3d: group,
+    data,
+    pages,
+    layout,
+    programs,
+    geometry,
+    get tick() { return tick; },
+    get debugMode() { return mode; },
+    get capacity() { return capacity; },
+    get count() { return pages.reduce((n, p) => n + p.alive.reduce((a, b) => a + b, 0), 0); },
+    stats,
+    /** Validate and write one body: O(slots), no geometry, material or pipeline is created. */
+    spawn({ seed = 0, position = [0, 0, 0] } = {}) {
+      if (!Number.isInteger(seed) || seed < 0 || seed > 0xffffffff) throw new Error(`spawn.seed: an integer in [0, 2^32) (got ${seed})`);
+      if (!Array.isArray(position) || position.length !== 3 || !position.every(Number.isFinite)) {
+        throw new Error('spawn.position: three finite numbers');
+      }
+      for (const page of pages) {
+        for (let j = 0; j < page.size; j++) {
+          if (page.alive[j]) continue;
+          const { tickOffset, yaw } = instanceOffset(seed, data.lcg, data.sway.period);
+          page.alive[j] = 1;
+          page.seed[j] = seed;
+          page.tickOffset[j] = tickOffset;
+          page.yaw[j] = yaw;
+          page.position.set(position, 3 * j);
+          writeInstance(page, j);
+          stats.spawns += 1;
+          return page.first + j;
+        }
+      }
+      throw new Error(`spawn: the population is full (capacity ${capacity}); create it with a larger capacity`);
+    },
+    despawn(id) {
+      const { page, j } = locate(id);
+      page.alive[j] = 0;
+      page.staging.fill(0, j * floatsPerInstance, (j + 1) * floatsPerInstance);
+      page.dirtyLo = Math.min(page.dirtyLo, j);
+      page.dirtyHi = Math.max(page.dirtyHi, j);
+    },
+    /** Advance whole ticks (the sway is closed form, so this equals seekTick(tick + n)). */
+    stepTicks(n = 1) {
+      for (let k = 0; k < n; k++) { tick += 1; stats.ticks += 1; }
+      setTick(tick);
+      return flush();
+    },
+    seekTick(n) {
+      if (!Number.isInteger(n) || n < 0) throw new Error(`seekTick: a non-negative integer (got ${n})`);
+      setTick(n);
+      return flush();
+    },
+    /** Upload whatever spawn/despawn left dirty (called by the owner before rendering). */
+    flush,
+    /** Internal: the page holding instance `id` and its index there. */
+    locate(id) {
+      const { page, j } = locate(id);
+      return { page, index: j };
+    },
+    instance(id) {
+      const { page, j } = locate(id);
+      return { index: j, alive: page.alive[j] === 1, seed: page.seed[j], tickOffset: page.tickOffset[j], yaw: page.yaw[j],
+        position: Array.from(page.position.subarray(3 * j, 3 * j + 3)), bounds: Array.from(page.bounds.subarray(6 * j, 6 * j + 6)) };
+    },
+    /** Pose rows of one instance from the CPU staging copy (what the next upload sends). */
+    stagedPose(id) {
+      const { page, j } = locate(id);
+      return page.staging.slice(j * floatsPerInstance, (j + 1) * floatsPerInstance);
+    },
+    stateHash() {
+      const parts = [];
+      for (const page of pages) parts.push(new Uint8Array(page.staging.buffer, page.staging.byteOffset, page.staging.byteLength));
+      let total = 0;
+      for (const p of parts) total += p.length;
+      const all = new Uint8Array(total);
+      let o = 0;
+      for (const p of parts) { all.set(p, o); o += p.length; }
+      return hashBytes(all, tick);
+    },
+    setDebugMode(m) {
+      for (const page of pages) page.mesh.material = materialFor(page, m);
+      mode = m;
+    },
+    setTier(t) {
+      if (t !== data.tier) throw new Error(`tier: this package was built for tier ${data.tier} (got ${t}); rebuild with --tier ${t}`);
+    },
+    variantKeys() { return [...variants.keys()]; },
+    /** Build every shipped variant's pipelines (display and shadow) before the first visible frame. */
+    async warm(scene, camera) {
+      const saved = pages.map((p) => p.mesh.count);
+      for (const page of pages) page.mesh.count = Math.max(1, page.mesh.count);
+      for (const m of SHIPPED_VARIANTS) {
+        for (const page of pages) page.mesh.material = materialFor(page, m);
+        await renderer.compileAsync(scene, camera);
+      }
+      for (const page of pages) page.mesh.material = materialFor(page, mode);
+      pages.forEach((p, i) => { p.mesh.count = saved[i]; });
+    },
+    dispose() {
+      geometry.dispose();
+      for (const material of variants.values()) material.dispose();
+      group.removeFromParent();
+    },
+  };
+  return population;
+}

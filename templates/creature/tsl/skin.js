@@ -1,0 +1,140 @@
+// Skinning the reference mesh from the pose page, and the bounded local correction: the formulas of
+// creaturegen's surface/deform.py (LBS, dual quaternion, centre of rotation; the method per vertex is
+// its joint's choice, baked into the asset) and of creature/reference.py (the per-vertex correction).
+import { Fn, If, Loop, Break, abs, float, int, select, sqrt, vec3, vec4 } from 'three/tsl';
+
+const dot3 = (u, v) => u.x.mul(v.x).add(u.y.mul(v.y)).add(u.z.mul(v.z));
+const dot4 = (u, v) => u.x.mul(v.x).add(u.y.mul(v.y)).add(u.z.mul(v.z)).add(u.w.mul(v.w));
+
+// R(q)·v by v + 2w(u×v) + 2u×(u×v), quaternions xyzw (the JS core's formula).
+export function rotate(q, v) {
+  const c = q.xyz.cross(v);
+  return v.add(c.mul(q.w).add(q.xyz.cross(c)).mul(2));
+}
+
+// a ⊗ b, xyzw.
+function qmul(a, b) {
+  return vec4(
+    a.w.mul(b.x).add(a.x.mul(b.w)).add(a.y.mul(b.z)).sub(a.z.mul(b.y)),
+    a.w.mul(b.y).sub(a.x.mul(b.z)).add(a.y.mul(b.w)).add(a.z.mul(b.x)),
+    a.w.mul(b.z).add(a.x.mul(b.y)).sub(a.y.mul(b.x)).add(a.z.mul(b.w)),
+    a.w.mul(b.w).sub(a.x.mul(b.x)).sub(a.y.mul(b.y)).sub(a.z.mul(b.z)),
+  );
+}
+
+export const METHOD = Object.freeze({ LBS: 0, DQ: 1, COR: 2 });
+
+/**
+ * Skinning and correction over one pose layout. `field` is createField's result; `correction` holds
+ * { budget, earlyOut, gradientFloor }.
+ */
+export function createSkin({ pose, rows, field, correction }) {
+  const quat = (base, s) => pose.element(base.add(s.mul(rows)).add(3));
+  const shift = (base, s) => pose.element(base.add(s.mul(rows)).add(4)).xyz;
+
+  // deform._lbs: v + Σ wᵢ((Rᵢ − I)v + tᵢ), which returns the rest vertex bit for bit at rest.
+  const lbs = (v, base, slots, weights) => {
+    const acc = vec3(0).toVar();
+    for (let c = 0; c < 4; c++) {
+      const s = int(slots.element(c));
+      const w = weights.element(c);
+      acc.addAssign(rotate(quat(base, s), v).sub(v).add(shift(base, s)).mul(w));
+    }
+    return v.add(acc);
+  };
+
+  // The dominant influence (largest weight, first on ties) and every influence's hemisphere sign.
+  const blendQuats = (base, slots, weights, withDual) => {
+    const dom = int(slots.x).toVar();
+    const best = weights.x.toVar();
+    for (let c = 1; c < 4; c++) {
+      If(weights.element(c).greaterThan(best), () => { best.assign(weights.element(c)); dom.assign(int(slots.element(c))); });
+    }
+    const ref = quat(base, dom).toVar();
+    const real = vec4(0).toVar();
+    const dual = vec4(0).toVar();
+    for (let c = 0; c < 4; c++) {
+      const s = int(slots.element(c));
+      const q = quat(base, s).toVar();
+      const sw = select(dot4(q, ref).lessThan(0), weights.element(c).negate(), weights.element(c));
+      real.addAssign(q.mul(sw));
+      if (withDual) dual.addAssign(qmul(vec4(shift(base, s), 0), q).mul(sw.mul(0.5)));
+    }
+    return { real, dual };
+  };
+
+  // deform._dq: normalised blended dual quaternion.
+  const dq = (v, base, slots, weights) => {
+    const { real, dual } = blendQuats(base, slots, weights, true);
+    const norm = sqrt(dot4(real, real));
+    const br = real.div(norm).toVar();
+    const bd = dual.div(norm);
+    const conj = vec4(br.xyz.negate(), br.w);
+    const translation = qmul(bd, conj).xyz.mul(2);
+    return rotate(br, v).add(translation);
+  };
+
+  // deform._cor: v' = R(v − p*) + LBS(p*), R the normalised blend of the hemisphere-aligned rotations.
+  const cor = (v, base, slots, weights, centre) => {
+    const { real } = blendQuats(base, slots, weights, false);
+    const br = real.div(sqrt(dot4(real, real)));
+    return rotate(br, v.sub(centre)).add(lbs(centre, base, slots, weights));
+  };
+
+  /** The skinned (uncorrected) position of one vertex; `method` is its joint's choice (0, 1, 2). */
+  const skinVertex = Fn(([v, base, slots, weights, method, centre]) => {
+    const out = vec3(0).toVar();
+    If(method.lessThan(0.5), () => { out.assign(lbs(v, base, slots, weights)); })
+      .ElseIf(method.lessThan(1.5), () => { out.assign(dq(v, base, slots, weights)); })
+      .Else(() => { out.assign(cor(v, base, slots, weights, centre)); });
+    return out;
+  });
+
+  /**
+   * Bounded Newton correction toward the zero set: Δp = −(d/|∇d|²)∇d clamped to the vertex's trust
+   * radius, halved on a failed trial, at most `budget` trials; the result is kept only if it improved
+   * |d| and its field normal still faces the skinned one (the per-vertex inversion proxy). Inline (call
+   * it inside a Fn): returns { position, gradient (raw, for the normal), distance, accepted } nodes.
+   */
+  const correctVertex = (p0, base, program, trust) => {
+    const r0 = field.runProgram(p0, base, program).toVar();
+    const p = p0.toVar();
+    const d = r0.x.toVar();
+    const g = r0.yzw.toVar();
+    const gg = dot3(g, g).toVar();
+    const accepted = float(0).toVar();
+    If(trust.greaterThan(0).and(gg.greaterThanEqual(correction.gradientFloor)), () => {
+      const start = abs(d).toVar();
+      const scale = float(1).toVar();
+      const step = vec3(0).toVar();
+      Loop(int(correction.budget), () => {
+        If(abs(d).lessThanEqual(trust.mul(correction.earlyOut)), () => { Break(); });
+        If(scale.equal(1), () => {
+          const s = g.mul(d.div(gg).negate()).toVar();
+          const len = sqrt(dot3(s, s));
+          If(len.greaterThan(trust), () => { s.mulAssign(trust.div(len)); });
+          step.assign(s);
+        });
+        const trial = p.add(step.mul(scale)).toVar();
+        const rt = field.runProgram(trial, base, program).toVar();
+        If(abs(rt.x).lessThan(abs(d)), () => {
+          p.assign(trial); d.assign(rt.x); g.assign(rt.yzw); gg.assign(dot3(g, g)); scale.assign(1);
+          If(gg.lessThan(correction.gradientFloor), () => { Break(); });
+        }).Else(() => { scale.mulAssign(0.5); });
+      });
+      const improved = abs(d).lessThan(start).or(abs(d).lessThanEqual(trust.mul(correction.earlyOut)));
+      const facing = dot3(g, r0.yzw).greaterThan(0);
+      If(improved.and(facing), () => { accepted.assign(1); });
+    });
+    const keep = accepted.greaterThan(0.5);
+    return {
+      position: select(keep, p, p0),
+      gradient: select(keep, g, r0.yzw),
+      distance: select(keep, d, r0.x),
+      accepted,
+    };
+  };
+
+  return { skinVertex, correctVertex, lbs, dq, cor };
+}
+
