@@ -297,8 +297,8 @@ def glb_bytes(asset: SurfaceAsset, *, name: str) -> bytes:
         "_WEIGHTS": b.add(asset.weights, FLOAT, "VEC4", target=ARRAY_BUFFER),
         "_CANDIDATE": b.add(asset.candidate.astype(np.float32), FLOAT, "SCALAR", target=ARRAY_BUFFER),
         "_RADIAL": b.add(asset.radial, FLOAT, "VEC2", target=ARRAY_BUFFER),
-        "_SKIN": b.add(asset.skin, FLOAT, "VEC2", target=ARRAY_BUFFER),
-        "_COR": b.add(asset.cor_centers, FLOAT, "VEC3", target=ARRAY_BUFFER),
+        "_SKIN": b.add(np.asarray(asset.skin), FLOAT, "VEC2", target=ARRAY_BUFFER),
+        "_COR": b.add(np.asarray(asset.cor_centers), FLOAT, "VEC3", target=ARRAY_BUFFER),
     }
     index_type = UNSIGNED_SHORT if asset.vertex_count <= MAX_UINT16_VERTICES else UNSIGNED_INT
     indices = b.add(asset.indices, index_type, "SCALAR", target=ELEMENT_ARRAY_BUFFER)
