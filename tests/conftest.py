@@ -2,7 +2,9 @@
 
 from __future__ import annotations
 
+import importlib
 import importlib.util
+import os
 import subprocess
 import sys
 from collections.abc import Iterator
@@ -21,6 +23,20 @@ SHARED_REFERENCE_SPECS = REPO.parent / "shared" / "reference-specs"
 @pytest.fixture
 def repo() -> Path:
     return REPO
+
+
+@pytest.fixture(scope="session", autouse=True)
+def surface_cache_root(tmp_path_factory: pytest.TempPathFactory) -> Iterator[str]:
+    """One surface cache for the whole session, also seen by CLI children through $CREATUREGEN_CACHE:
+    every example is extracted once, whichever test builds it first (surface, package or parity)."""
+    root = str(tmp_path_factory.mktemp("surface-cache"))
+    previous = os.environ.get("CREATUREGEN_CACHE")
+    os.environ["CREATUREGEN_CACHE"] = root
+    yield root
+    if previous is None:
+        os.environ.pop("CREATUREGEN_CACHE", None)
+    else:
+        os.environ["CREATUREGEN_CACHE"] = previous
 
 
 def run_cli(*args: str, cwd: Path = REPO) -> subprocess.CompletedProcess[str]:

@@ -56,8 +56,8 @@ def _built(name: str, cache_root: str) -> SurfaceBuild:
 
 
 @pytest.fixture(scope="module")
-def cache_root(tmp_path_factory: pytest.TempPathFactory) -> str:
-    return str(tmp_path_factory.mktemp("surface-cache"))
+def cache_root(surface_cache_root: str) -> str:
+    return surface_cache_root
 
 
 @pytest.mark.parametrize("name", CREATURES)

@@ -197,7 +197,7 @@ async function main() {
     },
     setTier(t) { pop.setTier(t); return t; },
     setDebugMode(m) { pop.setDebugMode(m); render(); return m; },
-    spawn(seed, count = 1, spacing = 1.5) {
+    spawn(seed, count = 1, spacing = 1.5, draw = true) {
       const ids = [];
       const side = Math.ceil(Math.sqrt(count));
       for (let i = 0; i < count; i++) {
@@ -207,10 +207,14 @@ async function main() {
         spawnTimes.push(performance.now() - start);
       }
       pop.flush();
-      render();
+      if (draw) render();
       return ids;
     },
-    despawnAll() { for (let i = 0; i < pop.capacity; i++) if (pop.instance(i).alive) pop.despawn(i); pop.flush(); },
+    despawnAll(keep = []) {
+      for (let i = 0; i < pop.capacity; i++) if (pop.instance(i).alive && !keep.includes(i)) pop.despawn(i);
+      pop.flush();
+      render();
+    },
     async probeField(points, id = 0, program = data.fullProgram) {
       const r = await diag.probeField(id, Float32Array.from(points), program);
       return Array.from(r);

@@ -277,11 +277,16 @@ def _parity(args: argparse.Namespace) -> int:
             )
             return EXIT_INVALID
         kind = json.loads(report_path.read_text()).get("kind")
-        if kind != "frost":
-            print(f"{name}: parity for {kind!r} packages is not implemented yet", file=sys.stderr)
+        if kind not in ("frost", "creature"):
+            print(f"{name}: unknown package kind {kind!r}", file=sys.stderr)
             return EXIT_INVALID
         print(f"==> parity {package.name}: headless Chromium, WebGPU on SwiftShader", flush=True)
-        report = run_frost_parity(package, (canvas[0], canvas[1]))
+        if kind == "creature":
+            from .lab.creature_parity import run_creature_parity
+
+            report = run_creature_parity(package, debug_pictures=args.debug_pictures)
+        else:
+            report = run_frost_parity(package, (canvas[0], canvas[1]))
         for gate in report.gates:
             value, threshold = gate["value"], gate["threshold"]
             print(f"  {gate['status']:4} {gate['name']}: {value:.4g} (threshold {threshold:.4g})")
@@ -356,7 +361,12 @@ def build_parser() -> argparse.ArgumentParser:
     parity.add_argument(
         "packages", nargs="+", metavar="PKG", help="package folders, e.g. out/frost-pane-full"
     )
-    parity.add_argument("--canvas", default="160x96", help="lab canvas size WxH (default: 160x96)")
+    parity.add_argument("--canvas", default="160x96", help="frost lab canvas size WxH (default: 160x96)")
+    parity.add_argument(
+        "--debug-pictures",
+        action="store_true",
+        help="creature packages: also write the distance, normals and candidates views as PNGs",
+    )
     parity.set_defaults(run=_parity)
     return parser
 

@@ -42,6 +42,8 @@ def creature_files(
     built = build_plan(spec, rig, surface, spec_sha256)
     plan = built.plan
     files = render_folder("creature", plan, spec_sha256)
+    # The exact spec bytes: the parity job rebuilds the Python reference (rig, field, skeleton) from them.
+    files.append(PackageFile("assets/spec.json", spec_bytes))
     files.append(PackageFile("assets/surface.glb", glb_bytes(surface.asset, name=str(plan["slug"]))))
     files.append(PackageFile("assets/surface.json", sidecar_bytes(stable_sidecar(surface.sidecar))))
     files.append(PackageFile("build-report.json", (to_json(build_report(plan, surface)) + "\n").encode()))

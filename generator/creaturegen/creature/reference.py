@@ -1,0 +1,141 @@
+"""The Python side of the creature parity job: what the lab's GPU readbacks are compared against.
+
+Everything here is the numpy float64 reference (field/sampler.py, surface/deform.py, creature/sway.py),
+rebuilt from the package's own ``assets/spec.json`` and ``assets/surface.glb``; nothing is read from the
+package's JS or computed by the browser.
+"""
+
+from __future__ import annotations
+
+import json
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+import numpy.typing as npt
+
+from ..field import layout as col
+from ..field.floors import floors_for
+from ..field.sampler import FieldSample, sample_graph
+from ..rig import CompiledRig, compile_rig
+from ..rig.graph import Ref
+from ..spec import CharacterSpec, validate_bytes
+from ..surface.asset import SurfaceAsset, read_glb
+from ..surface.deform import Pose, skin_cor, skin_dq, skin_lbs
+from ..surface.skeleton import build_skeleton
+from . import sway as sway_module
+
+F64 = npt.NDArray[np.float64]
+
+#: Share of the probe points placed on caps, taper interiors and blends (the rest fill the box).
+PROBE_MIX = {"caps": 0.25, "taper": 0.25, "blends": 0.25}
+
+
+@dataclass(frozen=True)
+class PackageReference:
+    spec: CharacterSpec
+    rig: CompiledRig
+    sway: sway_module.Sway
+    asset: SurfaceAsset
+    runtime: dict[str, object]
+
+
+def load_reference(package: Path) -> PackageReference:
+    spec_bytes = (package / "assets" / "spec.json").read_bytes()
+    spec = validate_bytes(spec_bytes, str(package / "assets" / "spec.json"))
+    if not isinstance(spec, CharacterSpec):
+        raise ValueError(f"{package}: assets/spec.json is not a creature spec")
+    rig = compile_rig(spec)
+    sway = sway_module.build_sway(rig, build_skeleton(spec, rig))
+    asset = read_glb(package / "assets" / "surface.glb")
+    text = (package / "core" / "data.js").read_text()
+    runtime = json.loads(text[text.index("Object.freeze(") + len("Object.freeze(") : text.rindex(");")])
+    return PackageReference(spec, rig, sway, asset, runtime)
+
+
+def instance_transforms(ref: PackageReference, tick: int, seed: int) -> tuple[F64, F64]:
+    offset, _ = sway_module.instance_offset(seed)
+    return sway_module.sway_transforms(ref.sway, tick + offset)
+
+
+def field_at(ref: PackageReference, table: F64, points: F64) -> FieldSample:
+    return sample_graph(ref.rig.graph, table, points, floors_for(ref.rig.body_scale).k_floor)
+
+
+def probe_points(table: F64, graph_pairs: list[tuple[int, int]], count: int, seed: int = 0) -> F64:
+    """Seeded points on caps, inside tapers, across blends and over the whole box (count in total)."""
+    rng = np.random.default_rng(seed)
+    a, b = table[:, col.A], table[:, col.B]
+    ra, rb = table[:, col.RA], table[:, col.RB]
+    n_slot = table.shape[0]
+    parts: list[F64] = []
+
+    def around(centre: F64, radius: F64, spread: float, n: int) -> F64:
+        direction = rng.normal(size=(n, 3))
+        direction /= np.linalg.norm(direction, axis=1, keepdims=True)
+        scale = radius[:, None] * (1.0 + spread * rng.uniform(-1.0, 1.0, (n, 1)))
+        result: F64 = centre + direction * scale
+        return result
+
+    n_caps = int(count * PROBE_MIX["caps"])
+    s = rng.integers(0, n_slot, n_caps)
+    end_b = rng.random(n_caps) < 0.5
+    parts.append(around(np.where(end_b[:, None], b[s], a[s]), np.where(end_b, rb[s], ra[s]), 0.3, n_caps))
+    n_taper = int(count * PROBE_MIX["taper"])
+    s = rng.integers(0, n_slot, n_taper)
+    t = rng.uniform(0.05, 0.95, (n_taper, 1))
+    parts.append(around(a[s] + (b[s] - a[s]) * t, ra[s] + (rb[s] - ra[s]) * t[:, 0], 0.6, n_taper))
+    n_blend = int(count * PROBE_MIX["blends"])
+    if graph_pairs:
+        pick = rng.integers(0, len(graph_pairs), n_blend)
+        i = np.array([graph_pairs[k][0] for k in pick])
+        j = np.array([graph_pairs[k][1] for k in pick])
+        mid_i = 0.5 * (a[i] + b[i])
+        mid_j = 0.5 * (a[j] + b[j])
+        w = rng.uniform(0.2, 0.8, (n_blend, 1))
+        parts.append(around(mid_i * (1 - w) + mid_j * w, 0.5 * (ra[i] + ra[j]), 0.8, n_blend))
+    lo = np.minimum(a, b).min(axis=0) - np.maximum(ra, rb).max()
+    hi = np.maximum(a, b).max(axis=0) + np.maximum(ra, rb).max()
+    rest = count - sum(p.shape[0] for p in parts)
+    parts.append(rng.uniform(lo, hi, (rest, 3)))
+    result: F64 = np.concatenate(parts)
+    return result
+
+
+def blend_pairs(rig: CompiledRig) -> list[tuple[int, int]]:
+    """Slot pairs meeting in a blend op (first leaf of each child), where blend regions lie."""
+
+    def first_leaf(ref: Ref) -> int:
+        while ref.kind == "op":
+            ref = rig.graph.ops[ref.index].children[0]
+        return ref.index
+
+    pairs = []
+    for op in rig.graph.ops:
+        leaves = [first_leaf(c) for c in op.children]
+        pairs += [(leaves[0], other) for other in leaves[1:]]
+    return pairs
+
+
+def skinned_reference(ref: PackageReference, pose: Pose) -> F64:
+    """Each vertex skinned in float64 by its baked method (LBS, DQ or CoR), as surface/deform.py does."""
+    asset = ref.asset
+    vertices = asset.positions.astype(np.float64)
+    normals = asset.normals.astype(np.float64)
+    indices = asset.slots.astype(np.int64)
+    weights = asset.weights.astype(np.float64)
+    method = np.asarray(asset.skin)[:, 0].astype(np.int64)
+    out = np.empty_like(vertices)
+    for code in (0, 1, 2):
+        rows = np.flatnonzero(method == code)
+        if rows.size == 0:
+            continue
+        v, n, i, w = vertices[rows], normals[rows], indices[rows], weights[rows]
+        if code == 0:
+            out[rows] = skin_lbs(v, n, i, w, pose).positions
+        elif code == 1:
+            out[rows] = skin_dq(v, n, i, w, pose).positions
+        else:
+            centres = np.asarray(asset.cor_centers)[rows].astype(np.float64)
+            out[rows] = skin_cor(v, n, i, w, pose, centres).positions
+    return out

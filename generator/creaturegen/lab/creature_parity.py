@@ -1,0 +1,291 @@
+"""The creature parity job: run a built package in the lab (headless Chromium, WebGPU on SwiftShader)
+and diff what the GPU computed, read back from the device, against the numpy reference.
+
+Gates, all measured in the run (thresholds are relative to the body scale L where they are lengths):
+- pose pages: the GPU pose rows after seekTick vs the Python sway in float32;
+- field: GPU probeField (a compute kernel running the material's own TSL field program) vs numpy float64
+  at ≥ 4096 seeded points on caps, inside tapers, across blends and over the box: |Δd| and the normal
+  angle (points where numpy's own float32 and float64 normals disagree by more than the tolerance sit on a
+  gradient seam and are counted, not gated);
+- skinning: GPU-skinned vertex positions vs numpy LBS/DQ/CoR on the same pose;
+- correction: every vertex the GPU corrected is no farther from the numpy posed field than its skinned
+  position, and the corrected residual is reported;
+- shadows: the silhouette seen from the sun vs the shadow footprint on the ground (the depth pass uses the
+  same position function), max distance of a disagreeing texel to the other mask's edge;
+- no GPU validation errors; no pipelines and no buffers created by 50 spawns after reveal;
+- stateHash(seekTick(n)) == stateHash(stepTicks(n)).
+"""
+
+from __future__ import annotations
+
+import base64
+import contextlib
+import json
+import time
+from collections.abc import Callable, Iterator
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import numpy.typing as npt
+from playwright.sync_api import Page
+from scipy import ndimage
+
+from ..creature import reference as cref
+from ..creature import sway as sway_module
+from ..surface.deform import Pose, quaternion_to_matrix
+from .browser import launch_lab_page
+from .frost_parity import ParityReport
+from .png import write_png
+from .server import serve
+
+REPO = Path(__file__).resolve().parents[3]
+WEB_LAB = REPO / "web_lab"
+DEFAULT_CANVAS = (192, 144)
+#: The pose tick the GPU gates run at (away from rest), and the seed of instance 0 (the lab's default).
+PARITY_TICK = 37
+LAB_SEED = 1
+PROBE_POINTS = 4096
+#: float32 tolerances relative to L: field distance, skinned position; normal angle in degrees.
+DISTANCE_TOL = 1e-5
+POSITION_TOL = 1e-5
+ANGLE_TOL_DEG = 0.05
+#: Corrected vertices may not end farther from the field than their skinned place (float32 slack × L).
+NEVER_WORSE_SLACK = 1e-6
+#: Silhouette vs shadow footprint: a disagreeing texel may lie at most this far from the other's edge.
+SHADOW_TEXELS = 2.0
+SPAWNS = 50
+
+F64 = npt.NDArray[np.float64]
+
+
+def _b64_floats(text: str) -> npt.NDArray[np.float32]:
+    return np.frombuffer(base64.b64decode(text), dtype=np.float32)
+
+
+def _rgba(shot: dict[str, Any]) -> npt.NDArray[np.uint8]:
+    raw = np.frombuffer(base64.b64decode(shot["rgba"]), dtype=np.uint8)
+    return raw.reshape(int(shot["height"]), int(shot["width"]), 4)
+
+
+@contextlib.contextmanager
+def open_creature_lab(package: Path, canvas: tuple[int, int] = DEFAULT_CANVAS) -> Iterator[Page]:
+    url_path = f"creature.html?pkg={package.name}&w={canvas[0]}&h={canvas[1]}&seed={LAB_SEED}"
+    with (
+        serve(WEB_LAB, mounts={"out": package.parent}) as base,
+        launch_lab_page(base + url_path, timeout_s=300) as lab_page,
+    ):
+        error = lab_page.lab.get("error")
+        if error:
+            raise RuntimeError(f"{package.name}: the lab failed to load the package: {error}")
+        yield lab_page.page
+
+
+def _counter_gates(page: Page, report: ParityReport) -> None:
+    page.evaluate("() => window.__lab.resetCounters()")
+    # Spawn without drawing, then one tick and one frame of all of them: a pipeline built at draw time
+    # would show up here too.
+    page.evaluate(f"() => window.__lab.spawn(1000, {SPAWNS}, 1.5, false)")
+    page.evaluate("() => window.__lab.stepTicks(1)")
+    page.evaluate("() => window.__lab.finish()")
+    after = page.evaluate("() => window.__lab.counters()")["sinceReveal"]
+    pipelines = after["createRenderPipeline"] + after["createRenderPipelineAsync"]
+    pipelines += after["createComputePipeline"] + after["createComputePipelineAsync"]
+    report.gate(f"pipelines created by {SPAWNS} spawns after reveal", pipelines, 0, "pipelines")
+    report.gate(f"buffers created by {SPAWNS} spawns after reveal", after["createBuffer"], 0, "buffers")
+    telemetry = page.evaluate("() => window.__lab.telemetry()")
+    report.measurements["population"] = {
+        "count": telemetry["count"],
+        "draws": telemetry["draws"],
+        "pages": telemetry["pages"],
+        "lastFrameBytes": telemetry["stats"]["lastFrameBytes"],
+        "spawnCost": page.evaluate("() => window.__lab.spawnCost()"),
+        "sinceReveal": after,
+    }
+    report.gate("draws per frame == pages in use", telemetry["draws"], 1, "draws")
+    page.evaluate("() => window.__lab.despawnAll([0])")
+
+
+def _hash_gate(page: Page, report: ParityReport) -> None:
+    page.evaluate("() => window.__lab.seekTick(0)")
+    page.evaluate(f"() => window.__lab.stepTicks({PARITY_TICK})")
+    stepped = page.evaluate("() => window.__lab.stateHash()")
+    page.evaluate("() => window.__lab.seekTick(5)")
+    page.evaluate(f"() => window.__lab.seekTick({PARITY_TICK})")
+    seeked = page.evaluate("() => window.__lab.stateHash()")
+    report.gate("stateHash(seekTick(n)) != stateHash(stepTicks(n))", float(stepped != seeked), 0, "mismatch")
+    report.measurements["stateHash"] = {"tick": PARITY_TICK, "stepped": stepped, "seeked": seeked}
+
+
+def _pose_and_field_gates(page: Page, ref: cref.PackageReference, report: ParityReport) -> None:
+    scale = ref.rig.body_scale
+    quats, trans = cref.instance_transforms(ref, PARITY_TICK, LAB_SEED)
+    gpu_rows = np.asarray(page.evaluate("() => window.__lab.readPose(0)"), dtype=np.float32)
+    rows = sway_module.pose_rows(ref.rig, quats, trans).reshape(-1)
+    report.gate(
+        "pose rows: GPU vs Python", float(np.abs(gpu_rows[: rows.size] - rows).max()) / scale, 1e-6, "L"
+    )
+    table = sway_module.posed_table(ref.rig, quats, trans)
+    points = cref.probe_points(table, cref.blend_pairs(ref.rig), PROBE_POINTS)
+    raw = page.evaluate("(p) => window.__lab.probeField(p)", points.reshape(-1).tolist())
+    gpu = np.asarray(raw, dtype=np.float64).reshape(-1, 4)
+    exact = cref.field_at(ref, table, points)
+    f32 = cref.field_at(ref, table, points.astype(np.float32).astype(np.float64))
+    dd = np.abs(gpu[:, 0] - exact.distance) / scale
+    report.gate(f"field |d_gpu - d_numpy| at {len(points)} points", float(dd.max()), DISTANCE_TOL, "L")
+
+    def angle(u: F64, v: F64) -> F64:
+        cos = (u * v).sum(1) / np.maximum(np.linalg.norm(u, axis=1) * np.linalg.norm(v, axis=1), 1e-300)
+        result: F64 = np.degrees(np.arccos(np.clip(cos, -1.0, 1.0)))
+        return result
+
+    # Points on a gradient seam (a tapered cap seam, a hard-min tie) are ill-conditioned for any float32
+    # evaluation: numpy's own float32 path already disagrees with float64 there.
+    seam = (
+        angle(np.asarray(f32.gradient, dtype=np.float64), np.asarray(exact.gradient, dtype=np.float64))
+        > ANGLE_TOL_DEG
+    )
+    theta = angle(gpu[:, 1:], np.asarray(exact.gradient, dtype=np.float64))[~seam]
+    report.gate("field normal angle GPU vs numpy (off seams)", float(theta.max()), ANGLE_TOL_DEG, "deg")
+    report.measurements["field"] = {
+        "points": len(points),
+        "seamPoints": int(seam.sum()),
+        "maxAbsDistanceL": float(dd.max()),
+        "p99AngleDeg": float(np.percentile(theta, 99)),
+    }
+
+
+def _skin_gates(page: Page, ref: cref.PackageReference, table: F64, report: ParityReport) -> None:
+    scale = ref.rig.body_scale
+    quats, trans = cref.instance_transforms(ref, PARITY_TICK, LAB_SEED)
+    wxyz = np.concatenate([quats[:, 3:4], quats[:, :3]], axis=1)
+    pose = Pose(quaternion_to_matrix(wxyz), trans)
+    got = page.evaluate("() => window.__lab.readSkinned(0)")
+    skinned = _b64_floats(got["skinned"]).reshape(-1, 3).astype(np.float64)
+    corrected = _b64_floats(got["corrected"]).reshape(-1, 3).astype(np.float64)
+    accepted = _b64_floats(got["accepted"]) > 0.5
+    expected = cref.skinned_reference(ref, pose)
+    error = np.linalg.norm(skinned - expected, axis=1) / scale
+    report.gate("GPU-skinned vertices vs numpy", float(error.max()), POSITION_TOL, "L")
+    field = cref.field_at(ref, table, np.concatenate([skinned, corrected]))
+    n = skinned.shape[0]
+    d_skin, d_corr = np.abs(field.distance[:n]), np.abs(field.distance[n:])
+    region = np.asarray(ref.asset.skin)[:, 1] > 0
+    worse = (d_corr - d_skin)[accepted] / scale
+    report.gate(
+        "corrected vertices never farther from the field than skinned",
+        float(worse.max()) if worse.size else 0.0,
+        NEVER_WORSE_SLACK,
+        "L",
+    )
+    report.gate(
+        "corrections outside the region policy", float(np.count_nonzero(accepted & ~region)), 0, "vertices"
+    )
+    report.measurements["correction"] = {
+        "region": int(region.sum()),
+        "accepted": int(accepted.sum()),
+        "residualSkinnedMaxL": float(d_skin[region].max() / scale) if region.any() else 0.0,
+        "residualCorrectedMaxL": float(d_corr[region].max() / scale) if region.any() else 0.0,
+        "residualSkinnedP99L": float(np.percentile(d_skin[region], 99) / scale) if region.any() else 0.0,
+        "residualCorrectedP99L": float(np.percentile(d_corr[region], 99) / scale) if region.any() else 0.0,
+        "wholeMeshMaxL": float(d_corr.max() / scale),
+    }
+
+
+def shadow_mismatch(silhouette: npt.NDArray[np.bool_], footprint: npt.NDArray[np.bool_]) -> tuple[float, int]:
+    """(largest distance in texels from a disagreeing texel to the other mask, disagreeing texels)."""
+    only_sil = silhouette & ~footprint
+    only_foot = footprint & ~silhouette
+    dist_to_foot = ndimage.distance_transform_edt(~footprint)
+    dist_to_sil = ndimage.distance_transform_edt(~silhouette)
+    worst = max(
+        float(dist_to_foot[only_sil].max()) if only_sil.any() else 0.0,
+        float(dist_to_sil[only_foot].max()) if only_foot.any() else 0.0,
+    )
+    return worst, int(only_sil.sum() + only_foot.sum())
+
+
+def _shadow_gate(page: Page, package: Path, report: ParityReport) -> None:
+    shot = page.evaluate("() => window.__lab.shadowParity(128)")
+    size = int(shot["size"])
+    sil = np.frombuffer(base64.b64decode(shot["silhouette"]), np.uint8).reshape(size, size, 4)
+    foot = np.frombuffer(base64.b64decode(shot["footprint"]), np.uint8).reshape(size, size, 4)
+    silhouette = sil[..., :3].max(axis=2) > 127
+    lum = foot[..., :3].astype(np.float64).mean(axis=2)
+    lit = float(np.median(lum[~silhouette])) if (~silhouette).any() else 255.0
+    footprint = lum < 0.5 * lit
+    worst, count = shadow_mismatch(silhouette, footprint)
+    report.gate("silhouette vs shadow footprint", worst, SHADOW_TEXELS, "texels")
+    report.measurements["shadow"] = {
+        "size": size,
+        "silhouetteTexels": int(silhouette.sum()),
+        "footprintTexels": int(footprint.sum()),
+        "disagreeingTexels": count,
+    }
+    write_png(package / "parity" / "silhouette.png", sil)
+    write_png(package / "parity" / "footprint.png", foot)
+
+
+def _pictures(page: Page, package: Path, debug: bool) -> None:
+    """front.png (the README's picture); with ``debug``, the distance, normals and candidates views too
+    (each is a material variant compiled on first use, ~10 s on SwiftShader)."""
+    write_png(
+        package / "parity" / "front.png", _rgba(page.evaluate("() => window.__lab.capturePixels('front')"))
+    )
+    for mode in ("distance", "normals", "candidates") if debug else ():
+        page.evaluate(f"() => window.__lab.setDebugMode('{mode}')")
+        shot = page.evaluate("() => window.__lab.capturePixels('front')")
+        write_png(package / "parity" / f"debug-{mode}.png", _rgba(shot))
+    page.evaluate("() => window.__lab.setDebugMode('off')")
+
+
+GATE_GROUPS = ("population", "hash", "field", "skin", "shadow")
+
+
+def run_creature_parity(
+    package: Path,
+    canvas: tuple[int, int] = DEFAULT_CANVAS,
+    groups: tuple[str, ...] = GATE_GROUPS,
+    debug_pictures: bool = False,
+) -> ParityReport:
+    """The creature gates (all groups by default) for one built package; writes parity/report.json and
+    PNGs (front.png always, debug views on request) into it. GPU validation errors are always gated."""
+    package = package.resolve()
+    ref = cref.load_reference(package)
+    report = ParityReport(package=package.name)
+    (package / "parity").mkdir(exist_ok=True)
+    seconds: dict[str, float] = {}
+    start = time.perf_counter()
+    with open_creature_lab(package, canvas) as page:
+        seconds["load"] = time.perf_counter() - start
+        report.measurements["adapter"] = page.evaluate("() => window.__lab.info()")["adapter"]
+        report.measurements["bootMs"] = page.evaluate("() => window.__lab.bootMs")
+
+        def phase(name: str, run: Callable[[], object]) -> None:
+            if name in groups:
+                t = time.perf_counter()
+                run()
+                seconds[name] = time.perf_counter() - t
+
+        phase("population", lambda: _counter_gates(page, report))
+        phase("hash", lambda: _hash_gate(page, report))
+        page.evaluate(f"() => window.__lab.seekTick({PARITY_TICK})")
+        quats, trans = cref.instance_transforms(ref, PARITY_TICK, LAB_SEED)
+        table = sway_module.posed_table(ref.rig, quats, trans)
+        phase("field", lambda: _pose_and_field_gates(page, ref, report))
+        phase("skin", lambda: _skin_gates(page, ref, table, report))
+        phase("shadow", lambda: _shadow_gate(page, package, report))
+        t = time.perf_counter()
+        _pictures(page, package, debug_pictures)
+        seconds["pictures"] = time.perf_counter() - t
+        page.evaluate("() => window.__lab.finish()")
+        errors: list[str] = page.evaluate("() => window.__lab.errors")
+        report.gate("GPU validation errors", len(errors), 0, "errors")
+        report.measurements["gpuErrors"] = errors[:20]
+        report.measurements["slots"] = ref.rig.slot_count
+        report.measurements["bodyScale"] = ref.rig.body_scale
+        report.measurements["seconds"] = seconds
+    (package / "parity" / "report.json").write_text(
+        json.dumps(report.as_dict(), indent=2, sort_keys=True) + "\n"
+    )
+    return report

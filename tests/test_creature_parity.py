@@ -1,0 +1,123 @@
+"""Creature parity through Playwright: every buildable example package on WebGPU (SwiftShader) against the
+numpy reference, with every gate of creaturegen.lab.creature_parity; plus proofs that the job catches a
+wrong GPU field formula and a shadow pass that does not use the deformed position. Fails (never skips)
+when the browser or node_modules is missing.
+
+The beetle is left out: its surface fails the euler gate at the hero tier (see test_surface_build.py).
+"""
+
+from __future__ import annotations
+
+import json
+import shutil
+from pathlib import Path
+
+import pytest
+
+from conftest import EXAMPLES, run_cli
+from creaturegen.lab.creature_parity import run_creature_parity
+from creaturegen.spec import slugify
+
+CREATURES = [
+    "reference/biped.json",
+    "reference/flyer.json",
+    "reference/hexapod.json",
+    "reference/hopper.json",
+    "reference/quadruped.json",
+    "reference/swimmer.json",
+    "lizard.json",
+    "moth.json",
+]
+
+
+@pytest.fixture(scope="module")
+def out_root(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    return tmp_path_factory.mktemp("creature-out")
+
+
+def build(name: str, out_root: Path) -> Path:
+    spec = EXAMPLES / name
+    package = out_root / slugify(json.loads(spec.read_text())["name"])
+    if not package.exists():
+        result = run_cli("build", str(spec), "-o", str(out_root))
+        assert result.returncode == 0, result.stdout[-2000:] + result.stderr[-4000:]
+    return package
+
+
+def describe(report: dict[str, object]) -> str:
+    gates = report["gates"]
+    assert isinstance(gates, list)
+    return "\n".join(
+        f"{g['status']:4} {g['name']}: {g['value']} (<= {g['threshold']} {g['unit']})" for g in gates
+    )
+
+
+@pytest.mark.browser
+@pytest.mark.parametrize("name", CREATURES)
+def test_every_example_passes_every_parity_gate(name: str, out_root: Path) -> None:
+    package = build(name, out_root)
+    report = run_creature_parity(package)
+    data = report.as_dict()
+    assert report.passed, describe(data)
+    written = json.loads((package / "parity" / "report.json").read_text())
+    assert written["status"] == "pass"
+    names = {g["name"] for g in written["gates"]}
+    for expected in (
+        "GPU validation errors",
+        "GPU-skinned vertices vs numpy",
+        "silhouette vs shadow footprint",
+    ):
+        assert expected in names
+    assert written["measurements"]["field"]["points"] >= 4096
+    assert (package / "parity" / "front.png").stat().st_size > 1000
+
+
+def _planted(package: Path, tmp_path: Path, file: str, swaps: list[tuple[str, str]]) -> Path:
+    """A copy of the package with a wrong GPU formula (the Python reference is untouched)."""
+    copy = tmp_path / package.name
+    shutil.copytree(package, copy)
+    path = copy / "tsl" / file
+    text = path.read_text()
+    for old, new in swaps:
+        assert old in text, f"the planted error no longer applies: {old!r} not in {file}"
+        text = text.replace(old, new)
+    path.write_text(text)
+    return copy
+
+
+@pytest.mark.browser
+def test_the_job_catches_a_field_formula_without_the_taper_term(out_root: Path, tmp_path: Path) -> None:
+    package = build("reference/hopper.json", out_root)
+    planted = _planted(
+        package,
+        tmp_path,
+        "field.js",
+        [
+            # Tapered form: the radius no longer varies along the segment.
+            ("const d = x.sub(ra.add(rb.sub(ra).mul(t)));", "const d = x.sub(ra);"),
+            # Round cone: the side distance loses its axial (taper) term.
+            ("const sideD = sn.mul(tRaw.mul(len)).add(c.mul(x)).sub(ra);", "const sideD = c.mul(x).sub(ra);"),
+        ],
+    )
+    report = run_creature_parity(planted, groups=("field",))
+    failed = {g["name"] for g in report.gates if g["status"] == "fail"}
+    assert any(name.startswith("field |d_gpu - d_numpy|") for name in failed), describe(report.as_dict())
+
+
+@pytest.mark.browser
+def test_the_job_catches_a_shadow_pass_that_ignores_the_deformation(out_root: Path, tmp_path: Path) -> None:
+    package = build("reference/hopper.json", out_root)
+    planted = _planted(
+        package,
+        tmp_path,
+        "material.js",
+        [
+            (
+                "  material.colorNode = vColour;",
+                "  material.colorNode = vColour;\n  material.castShadowPositionNode = positionGeometry;",
+            )
+        ],
+    )
+    report = run_creature_parity(planted, groups=("shadow",))
+    failed = {g["name"] for g in report.gates if g["status"] == "fail"}
+    assert "silhouette vs shadow footprint" in failed, describe(report.as_dict())
