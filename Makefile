@@ -13,10 +13,11 @@ VENV_PY := $(VENV)/bin/python
 VENV_STAMP := $(VENV)/.installed
 WEB_LAB := web_lab
 NODE_STAMP := $(WEB_LAB)/node_modules/.package-lock.json
-# The default example is a frost effect: its package is emitted end to end. Creature specs validate and
-# compile (inspect/probe), but their package emitter is not written yet (issue 5).
-EXAMPLE ?= examples/frost/frost-full.json
+# The default example is a creature (the product's spine); frost effects build the same way.
+EXAMPLE ?= examples/reference/hopper.json
 FROST_EXAMPLES := $(wildcard examples/frost/*.json)
+# Every creature example that builds; the beetle fails its surface euler gate at the hero tier (known).
+CREATURE_EXAMPLES := $(wildcard examples/reference/*.json) examples/lizard.json examples/moth.json
 LAB_HOST ?= 127.0.0.1
 LAB_PORT ?= 8765
 # Extra pytest arguments for local runs, e.g. PYTEST_ARGS='-k smoke'. CI leaves it empty: every test
@@ -30,7 +31,7 @@ LINT_PATHS := $(wildcard generator tests bench)
 help:
 	@echo "make setup    .venv + pip install -e '.[dev]', npm ci in $(WEB_LAB), chromium + lavapipe"
 	@echo "make build    creaturegen build \$$EXAMPLE (now $(EXAMPLE)) into out/"
-	@echo "make parity   build every frost example and run its parity job (out/<slug>/parity/)"
+	@echo "make parity   build every frost and creature example and run its parity job (out/<slug>/parity/)"
 	@echo "make test     ruff, ruff format --check, mypy, pytest (browser tests included)"
 	@echo "make schemas  export JSON Schemas into schemas/"
 	@echo "make lab      serve $(WEB_LAB)/ at http://$(LAB_HOST):$(LAB_PORT)/"
@@ -72,7 +73,7 @@ build: setup
 SLUG_OF := $(VENV_PY) -c 'import json, sys; from creaturegen.spec import slugify; print(slugify(json.load(open(sys.argv[1]))["name"]))'
 
 parity: setup
-	@pkgs=""; for spec in $(FROST_EXAMPLES); do \
+	@pkgs=""; for spec in $(FROST_EXAMPLES) $(CREATURE_EXAMPLES); do \
 	  echo "==> creaturegen build $$spec"; $(VENV)/bin/creaturegen build $$spec >/dev/null || exit 2; \
 	  pkgs="$$pkgs out/$$($(SLUG_OF) $$spec)"; done; \
 	$(VENV)/bin/creaturegen parity $$pkgs
@@ -82,7 +83,7 @@ schemas: $(VENV_STAMP)
 	$(VENV)/bin/creaturegen schema --out schemas
 
 lab: $(VENV_STAMP) $(NODE_STAMP)
-	$(VENV_PY) -m creaturegen.lab.server --root $(WEB_LAB) --out out --host $(LAB_HOST) --port $(LAB_PORT)
+	$(VENV)/bin/creaturegen lab --out out --host $(LAB_HOST) --port $(LAB_PORT)
 
 bench: setup
 	@echo "==> field benchmark into bench/results/field.json"

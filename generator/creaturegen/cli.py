@@ -295,6 +295,18 @@ def _parity(args: argparse.Namespace) -> int:
     return EXIT_GATE_FAILED if failed else EXIT_OK
 
 
+def _lab(args: argparse.Namespace) -> int:
+    from .lab import server
+
+    argv = ["--root", str(server_root()), "--out", args.out, "--host", args.host, "--port", str(args.port)]
+    return server.main(argv)
+
+
+def server_root() -> Path:
+    """web_lab/ of this checkout (the lab is a static app beside the generator)."""
+    return Path(__file__).resolve().parents[2] / "web_lab"
+
+
 def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(
         prog="creaturegen",
@@ -368,6 +380,12 @@ def build_parser() -> argparse.ArgumentParser:
         help="creature packages: also write the distance, normals and candidates views as PNGs",
     )
     parity.set_defaults(run=_parity)
+
+    lab = commands.add_parser("lab", help="serve the web lab on a fixed port and print the URLs")
+    lab.add_argument("--out", default="out", help="built packages, served at /out/ (default: out)")
+    lab.add_argument("--host", default="127.0.0.1", help="bind address (default: 127.0.0.1)")
+    lab.add_argument("--port", type=int, default=8765, help="port (default: 8765)")
+    lab.set_defaults(run=_lab)
     return parser
 
 

@@ -11,6 +11,7 @@ import argparse
 import contextlib
 import functools
 import http.server
+import json
 import os
 import posixpath
 import sys
@@ -133,6 +134,12 @@ def main(argv: Sequence[str] | None = None) -> int:
     print(f"==> serving {Path(args.root).resolve()} at {base}; packages: {Path(args.out).resolve()} at /out/")
     print(f"    {base}smoke.html  WebGPU smoke page")
     print(f"    {base}frost.html?pkg=<slug>  a built frost package, e.g. after `make build EXAMPLE=...`")
+    print(f"    {base}creature.html?pkg=<slug>  a built creature package")
+    for report in sorted(Path(args.out).glob("*/build-report.json")):
+        kind = json.loads(report.read_text()).get("kind")
+        page = {"frost": "frost.html", "creature": "creature.html"}.get(str(kind))
+        if page:
+            print(f"    {base}{page}?pkg={report.parent.name}")
     print("    Ctrl-C stops the server", flush=True)
     try:
         server.serve_forever()
