@@ -26,7 +26,7 @@ PYTEST_ARGS ?=
 # Only folders that exist: git does not keep empty ones, and ruff fails on a missing path.
 LINT_PATHS := $(wildcard generator tests bench)
 
-.PHONY: help setup system-deps build parity test schemas lab bench clean distclean
+.PHONY: help setup system-deps build parity test schemas lab bench golden clean distclean
 
 help:
 	@echo "make setup    .venv + pip install -e '.[dev]', npm ci in $(WEB_LAB), chromium + lavapipe"
@@ -34,6 +34,7 @@ help:
 	@echo "make parity   build every frost and creature example and run its parity job (out/<slug>/parity/)"
 	@echo "make test     ruff, ruff format --check, mypy, pytest (browser tests included)"
 	@echo "make schemas  export JSON Schemas into schemas/"
+	@echo "make golden   rebuild tests/golden/ (the byte-for-byte package records); review and commit the diff"
 	@echo "make lab      serve $(WEB_LAB)/ at http://$(LAB_HOST):$(LAB_PORT)/"
 	@echo "make bench    bench/results/field.json (candidates, analytic vs FD), frost.json (tiers, tiles, idle),"
 	@echo "              surface.json (narrow band vs dense, numpy vs wgpu, extraction, gates)"
@@ -81,6 +82,10 @@ parity: setup
 schemas: $(VENV_STAMP)
 	@echo "==> exporting JSON Schemas into schemas/"
 	$(VENV)/bin/creaturegen schema --out schemas
+
+golden: $(VENV_STAMP)
+	@echo "==> regenerating tests/golden/ (commit the result)"
+	$(VENV_PY) tools/regen-golden.py
 
 lab: $(VENV_STAMP) $(NODE_STAMP)
 	$(VENV)/bin/creaturegen lab --out out --host $(LAB_HOST) --port $(LAB_PORT)

@@ -45,7 +45,8 @@ def creature_files(
     # The exact spec bytes: the parity job rebuilds the Python reference (rig, field, skeleton) from them.
     files.append(PackageFile("assets/spec.json", spec_bytes))
     files.append(PackageFile("assets/surface.glb", glb_bytes(surface.asset, name=str(plan["slug"]))))
-    files.append(PackageFile("assets/surface.json", sidecar_bytes(stable_sidecar(surface.sidecar))))
+    sidecar = {"//": header_text(spec_sha256), **stable_sidecar(surface.sidecar)}
+    files.append(PackageFile("assets/surface.json", sidecar_bytes(sidecar)))
     files.append(PackageFile("build-report.json", (to_json(build_report(plan, surface)) + "\n").encode()))
     return files
 

@@ -98,8 +98,12 @@ export function createField({ pose, programs, rows, registers, gradientFloor, ti
     return vec4(d, l.yzw.mul(omh).add(r.yzw.mul(h)));
   };
 
-  /** Run program `program` at point `p` for the instance whose pose rows start at `base`: vec4(d, ∇d). */
-  const runProgram = Fn(([p, base, program]) => {
+  /**
+   * Run program `program` at point `p` for the instance whose pose rows start at `base`, inline (call it
+   * inside a Fn). Returns { value: vec4(d, ∇d), colour }: with `colour`, field/colour.proximity_colour
+   * over the program's leaves, read from the leaf registers this run already filled (linear RGB).
+   */
+  const evaluate = (p, base, program, { colour = false, kFloor = 0 } = {}) => {
     const header = programs.element(program);
     const offset = int(header.x).toVar();
     const count = int(header.y).toVar();
@@ -132,36 +136,30 @@ export function createField({ pose, programs, rows, registers, gradientFloor, ti
         regs.element(i).assign(select(r.x.lessThan(l.x), r, l));
       });
     });
-    return regs.element(count.sub(1));
-  });
-
-  /** field/colour.proximity_colour over the program's leaves (linear RGB). */
-  const programColour = Fn(([p, base, program, kFloor]) => {
-    const header = programs.element(program);
-    const offset = int(header.x).toVar();
-    const count = int(header.y).toVar();
+    const value = regs.element(count.sub(1)).toVar();
+    if (!colour) return { value, colour: null };
     const dMin = float(3.4e38).toVar();
     Loop(count, ({ i }) => {
-      const ins = programs.element(offset.add(i));
-      If(int(ins.x).equal(OP.LEAF), () => { dMin.assign(min(dMin, slotField(p, base, int(ins.y)).x)); });
+      If(int(programs.element(offset.add(i)).x).equal(OP.LEAF), () => { dMin.assign(min(dMin, regs.element(i).x)); });
     });
     const sum = float(0).toVar();
     const rgb = vec3(0).toVar();
     Loop(count, ({ i }) => {
       const ins = programs.element(offset.add(i));
       If(int(ins.x).equal(OP.LEAF), () => {
-        const slot = int(ins.y);
-        const d = slotField(p, base, slot).x;
-        const row = pose.element(base.add(slot.mul(rows)).add(2));
-        const w = exp(max(d.sub(dMin), 0).negate().div(max(row.x, kFloor)));
+        const row = pose.element(base.add(int(ins.y).mul(rows)).add(2));
+        const w = exp(max(regs.element(i).x.sub(dMin), 0).negate().div(max(row.x, kFloor)));
         sum.addAssign(w);
         rgb.addAssign(row.yzw.mul(w));
       });
     });
-    return rgb.div(sum);
-  });
+    return { value, colour: rgb.div(sum) };
+  };
 
-  return { slotField, runProgram, programColour };
+  /** vec4(d, ∇d) of program `program` at `p` (evaluate without the colour). */
+  const runProgram = Fn(([p, base, program]) => evaluate(p, base, program).value);
+
+  return { slotField, evaluate, runProgram };
 }
 
 

@@ -42,18 +42,20 @@ export function bodyFunctions(layout, pose, programs) {
 const hashColour = (n) => vec3(fract(sin(n.mul(12.9898)).mul(43758.5453)), fract(sin(n.mul(78.233)).mul(12543.37)), fract(sin(n.mul(3.7719)).mul(9821.13)));
 
 /**
- * One vertex through the whole body path, inline in a Fn: skin, correct (unless skin-only), field normal.
+ * One vertex through the whole body path, inline in a Fn: skin, correct (unless skin-only), then one
+ * field evaluation at the final position for the normal, the distance and (with `colour`) the albedo.
  * Inputs are nodes so the vertex stage (attributes) and the diagnostics kernels (storage) share it.
  */
-export function bodyVertex(layout, fns, { rest, slots, weights, skin, cor, base, skinOnly }) {
+export function bodyVertex(layout, fns, { rest, slots, weights, skin, cor, base, skinOnly, colour = false }) {
   const program = select(skin.z.greaterThan(layout.noProgram - 0.5), int(layout.fullProgram), int(skin.z)).toVar();
   const skinned = fns.skin.skinVertex(rest, base, slots, weights, skin.x, cor).toVar();
-  if (skinOnly) {
-    const r = fns.field.runProgram(skinned, base, program).toVar();
-    return { skinned, position: skinned, gradient: r.yzw, distance: r.x, accepted: float(0), program };
-  }
-  const c = fns.skin.correctVertex(skinned, base, program, skin.y);
-  return { skinned, ...c, program };
+  const corrected = skinOnly ? { position: skinned, accepted: float(0) } : fns.skin.correctVertex(skinned, base, program, skin.y);
+  // One evaluation at the final position: the normal's gradient, the distance and (display) the colour.
+  const final = fns.field.evaluate(corrected.position, base, program, { colour, kFloor: layout.kFloor });
+  return {
+    skinned, position: corrected.position, accepted: corrected.accepted, program,
+    gradient: final.value.yzw, distance: final.value.x, colour: final.colour,
+  };
 }
 
 /** The display material of a page for one debug mode (a variant; cached by the population). */
@@ -70,7 +72,7 @@ export function createBodyMaterial(layout, pose, programs, mode) {
     const weights = attribute('cgWeights', 'vec4');
     const body = bodyVertex(layout, fns, {
       rest: positionGeometry, slots: attribute('cgSlots', 'vec4'), weights, skin: skinAttr,
-      cor: attribute('cgCor', 'vec3'), base, skinOnly: mode === 'skin-only',
+      cor: attribute('cgCor', 'vec3'), base, skinOnly: mode === 'skin-only', colour: mode === 'off' || mode === 'skin-only',
     });
     const p = body.position.toVar();
     const n = normalize(body.gradient).toVar();
@@ -85,7 +87,7 @@ export function createBodyMaterial(layout, pose, programs, mode) {
     } else if (mode === 'candidates') {
       colour = hashColour(float(body.program).add(1));
     } else {
-      colour = fns.field.programColour(p, base, body.program, layout.kFloor);
+      colour = body.colour;
     }
     vColour.assign(colour);
     // Root transform (yaw about +y, then translation), applied exactly once, to position and normal.

@@ -93,46 +93,44 @@ export function createSkin({ pose, rows, field, correction }) {
   /**
    * Bounded Newton correction toward the zero set: Δp = −(d/|∇d|²)∇d clamped to the vertex's trust
    * radius, halved on a failed trial, at most `budget` trials; the result is kept only if it improved
-   * |d| and its field normal still faces the skinned one (the per-vertex inversion proxy). Inline (call
-   * it inside a Fn): returns { position, gradient (raw, for the normal), distance, accepted } nodes.
+   * |d| and its field normal still faces the skinned one (the per-vertex inversion proxy). Only vertices
+   * with a positive trust radius (the build's region policy) run it. Inline (call it inside a Fn):
+   * returns { position, accepted } nodes.
    */
   const correctVertex = (p0, base, program, trust) => {
-    const r0 = field.runProgram(p0, base, program).toVar();
-    const p = p0.toVar();
-    const d = r0.x.toVar();
-    const g = r0.yzw.toVar();
-    const gg = dot3(g, g).toVar();
+    const out = p0.toVar();
     const accepted = float(0).toVar();
-    If(trust.greaterThan(0).and(gg.greaterThanEqual(correction.gradientFloor)), () => {
-      const start = abs(d).toVar();
-      const scale = float(1).toVar();
-      const step = vec3(0).toVar();
-      Loop(int(correction.budget), () => {
-        If(abs(d).lessThanEqual(trust.mul(correction.earlyOut)), () => { Break(); });
-        If(scale.equal(1), () => {
-          const s = g.mul(d.div(gg).negate()).toVar();
-          const len = sqrt(dot3(s, s));
-          If(len.greaterThan(trust), () => { s.mulAssign(trust.div(len)); });
-          step.assign(s);
+    If(trust.greaterThan(0), () => {
+      const r0 = field.runProgram(p0, base, program).toVar();
+      const p = p0.toVar();
+      const d = r0.x.toVar();
+      const g = r0.yzw.toVar();
+      const gg = dot3(g, g).toVar();
+      If(gg.greaterThanEqual(correction.gradientFloor), () => {
+        const start = abs(d).toVar();
+        const scale = float(1).toVar();
+        const step = vec3(0).toVar();
+        Loop(int(correction.budget), () => {
+          If(abs(d).lessThanEqual(trust.mul(correction.earlyOut)), () => { Break(); });
+          If(scale.equal(1), () => {
+            const s = g.mul(d.div(gg).negate()).toVar();
+            const len = sqrt(dot3(s, s));
+            If(len.greaterThan(trust), () => { s.mulAssign(trust.div(len)); });
+            step.assign(s);
+          });
+          const trial = p.add(step.mul(scale)).toVar();
+          const rt = field.runProgram(trial, base, program).toVar();
+          If(abs(rt.x).lessThan(abs(d)), () => {
+            p.assign(trial); d.assign(rt.x); g.assign(rt.yzw); gg.assign(dot3(g, g)); scale.assign(1);
+            If(gg.lessThan(correction.gradientFloor), () => { Break(); });
+          }).Else(() => { scale.mulAssign(0.5); });
         });
-        const trial = p.add(step.mul(scale)).toVar();
-        const rt = field.runProgram(trial, base, program).toVar();
-        If(abs(rt.x).lessThan(abs(d)), () => {
-          p.assign(trial); d.assign(rt.x); g.assign(rt.yzw); gg.assign(dot3(g, g)); scale.assign(1);
-          If(gg.lessThan(correction.gradientFloor), () => { Break(); });
-        }).Else(() => { scale.mulAssign(0.5); });
+        const improved = abs(d).lessThan(start).or(abs(d).lessThanEqual(trust.mul(correction.earlyOut)));
+        const facing = dot3(g, r0.yzw).greaterThan(0);
+        If(improved.and(facing), () => { accepted.assign(1); out.assign(p); });
       });
-      const improved = abs(d).lessThan(start).or(abs(d).lessThanEqual(trust.mul(correction.earlyOut)));
-      const facing = dot3(g, r0.yzw).greaterThan(0);
-      If(improved.and(facing), () => { accepted.assign(1); });
     });
-    const keep = accepted.greaterThan(0.5);
-    return {
-      position: select(keep, p, p0),
-      gradient: select(keep, g, r0.yzw),
-      distance: select(keep, d, r0.x),
-      accepted,
-    };
+    return { position: out, accepted };
   };
 
   return { skinVertex, correctVertex, lbs, dq, cor };
