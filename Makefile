@@ -37,7 +37,8 @@ help:
 	@echo "make golden   rebuild tests/golden/ (the byte-for-byte package records); review and commit the diff"
 	@echo "make lab      serve $(WEB_LAB)/ at http://$(LAB_HOST):$(LAB_PORT)/"
 	@echo "make bench    bench/results/field.json (candidates, analytic vs FD), frost.json (tiers, tiles, idle),"
-	@echo "              surface.json (narrow band vs dense, numpy vs wgpu, extraction, gates)"
+	@echo "              surface.json (narrow band vs dense, numpy vs wgpu, extraction, gates),"
+	@echo "              runtime.json (creature frame p50/p95 vs bodies, per-body cost, baseline vs 7P/K, spawns)"
 	@echo "make clean    remove build output and caches; distclean also removes .venv and node_modules"
 
 # --- setup ------------------------------------------------------------------------------------
@@ -97,6 +98,8 @@ bench: setup
 	$(VENV_PY) bench/frost.py --out bench/results/frost.json
 	@echo "==> surface benchmark (narrow band vs dense, numpy vs wgpu, extraction, gates) into bench/results/surface.json"
 	$(VENV_PY) bench/surface.py --out bench/results/surface.json
+	@echo "==> runtime benchmark (creature population on WebGPU/SwiftShader, shipped vs forbidden baseline) into bench/results/runtime.json"
+	$(VENV_PY) bench/runtime.py --out bench/results/runtime.json
 
 # --- checks -----------------------------------------------------------------------------------
 
