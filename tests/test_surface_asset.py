@@ -143,7 +143,16 @@ def test_glb_framing_alignment_and_json(tmp_path: Path) -> None:
     (primitive,) = meshes[0]["primitives"]
     assert primitive["mode"] == 4
     attributes = primitive["attributes"]
-    assert set(attributes) == {"POSITION", "NORMAL", "_SLOTS", "_WEIGHTS", "_CANDIDATE", "_RADIAL"}
+    assert set(attributes) == {
+        "POSITION",
+        "NORMAL",
+        "_SLOTS",
+        "_WEIGHTS",
+        "_CANDIDATE",
+        "_RADIAL",
+        "_SKIN",
+        "_COR",
+    }
     formats = {name: (accessors[i]["componentType"], accessors[i]["type"]) for name, i in attributes.items()}
     assert formats == {
         "POSITION": (5126, "VEC3"),
@@ -152,6 +161,8 @@ def test_glb_framing_alignment_and_json(tmp_path: Path) -> None:
         "_WEIGHTS": (5126, "VEC4"),
         "_CANDIDATE": (5126, "SCALAR"),
         "_RADIAL": (5126, "VEC2"),
+        "_SKIN": (5126, "VEC2"),
+        "_COR": (5126, "VEC3"),
     }
     for name, i in attributes.items():
         view = views[accessors[i]["bufferView"]]
@@ -281,7 +292,16 @@ def test_three_gltfloader_reads_the_asset(tmp_path: Path) -> None:
     # Unknown attribute names are lower-cased by GLTFLoader; POSITION/NORMAL map to three's names.
     attributes = report["attributes"]
     assert isinstance(attributes, dict)
-    assert set(attributes) == {"position", "normal", "_slots", "_weights", "_candidate", "_radial"}
+    assert set(attributes) == {
+        "position",
+        "normal",
+        "_slots",
+        "_weights",
+        "_candidate",
+        "_radial",
+        "_skin",
+        "_cor",
+    }
 
     expected: dict[str, tuple[npt.NDArray[Any], str]] = {
         "position": (asset.positions, "Float32Array"),
@@ -290,6 +310,8 @@ def test_three_gltfloader_reads_the_asset(tmp_path: Path) -> None:
         "_weights": (asset.weights, "Float32Array"),
         "_candidate": (asset.candidate, "Float32Array"),
         "_radial": (asset.radial, "Float32Array"),
+        "_skin": (np.asarray(asset.skin), "Float32Array"),
+        "_cor": (np.asarray(asset.cor_centers), "Float32Array"),
     }
     for name, (values, array_type) in expected.items():
         seen = attributes[name]
@@ -307,7 +329,7 @@ def test_three_gltfloader_reads_the_asset(tmp_path: Path) -> None:
 
     user_data = report["userData"]
     assert isinstance(user_data, dict)
-    assert user_data["restFramesAccessor"] == 7
+    assert user_data["restFramesAccessor"] == 9  # after 8 attributes and the indices
     assert {k: user_data[k] for k in EXTRAS} == EXTRAS
     assert report["assetExtras"] == EXTRAS
 
