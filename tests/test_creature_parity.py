@@ -18,20 +18,9 @@ from pathlib import Path
 
 import pytest
 
-from conftest import EXAMPLES, run_cli
+from conftest import CREATURE_EXAMPLES, EXAMPLES, run_cli
 from creaturegen.lab.creature_parity import GATE_GROUPS, run_creature_parity
 from creaturegen.spec import slugify
-
-CREATURES = [
-    "reference/biped.json",
-    "reference/flyer.json",
-    "reference/hexapod.json",
-    "reference/hopper.json",
-    "reference/quadruped.json",
-    "reference/swimmer.json",
-    "lizard.json",
-    "moth.json",
-]
 
 
 @pytest.fixture(scope="module")
@@ -48,26 +37,17 @@ def build(name: str, out_root: Path) -> Path:
     return package
 
 
-def describe(report: dict[str, object]) -> str:
-    gates = report["gates"]
-    assert isinstance(gates, list)
-    return "\n".join(
-        f"{g['status']:4} {g['name']}: {g['value']} (<= {g['threshold']} {g['unit']})" for g in gates
-    )
-
-
 #: The example whose parity run also draws the 50-spawn population frame.
 POPULATION_EXAMPLE = "reference/hopper.json"
 
 
 @pytest.mark.browser
-@pytest.mark.parametrize("name", CREATURES)
+@pytest.mark.parametrize("name", CREATURE_EXAMPLES)
 def test_every_example_passes_every_parity_gate(name: str, out_root: Path) -> None:
     package = build(name, out_root)
     groups = GATE_GROUPS if name == POPULATION_EXAMPLE else tuple(g for g in GATE_GROUPS if g != "population")
     report = run_creature_parity(package, groups=groups)
-    data = report.as_dict()
-    assert report.passed, describe(data)
+    assert report.passed, report.summary()
     written = json.loads((package / "parity" / "report.json").read_text())
     assert written["status"] == "pass"
     names = {g["name"] for g in written["gates"]}
@@ -110,7 +90,7 @@ def test_the_job_catches_a_field_formula_without_the_taper_term(out_root: Path, 
     )
     report = run_creature_parity(planted, groups=("field",))
     failed = {g["name"] for g in report.gates if g["status"] == "fail"}
-    assert any(name.startswith("field |d_gpu - d_numpy|") for name in failed), describe(report.as_dict())
+    assert any(name.startswith("field |d_gpu - d_numpy|") for name in failed), report.summary()
 
 
 @pytest.mark.browser
@@ -129,4 +109,4 @@ def test_the_job_catches_a_shadow_pass_that_ignores_the_deformation(out_root: Pa
     )
     report = run_creature_parity(planted, groups=("shadow",))
     failed = {g["name"] for g in report.gates if g["status"] == "fail"}
-    assert "silhouette vs shadow footprint" in failed, describe(report.as_dict())
+    assert "silhouette vs shadow footprint" in failed, report.summary()

@@ -29,14 +29,6 @@ def built(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Path]:
     return packages
 
 
-def describe(report: dict[str, object]) -> str:
-    gates = report["gates"]
-    assert isinstance(gates, list)
-    return "\n".join(
-        f"{g['status']:4} {g['name']}: {g['value']} (<= {g['threshold']} {g['unit']})" for g in gates
-    )
-
-
 @pytest.mark.browser
 @pytest.mark.parametrize("example", [p.stem for p in FROST_EXAMPLES])
 def test_frost_package_passes_every_parity_gate(built: dict[str, Path], example: str) -> None:
@@ -44,7 +36,7 @@ def test_frost_package_passes_every_parity_gate(built: dict[str, Path], example:
     report = run_frost_parity(package)
     written = json.loads((package / "parity" / "report.json").read_text())
     assert written["status"] == ("pass" if report.passed else "fail")
-    assert report.passed, describe(written)
+    assert report.passed, report.summary()
     names = {g["name"] for g in written["gates"]}
     assert {
         "GPU vs numpy history at 30 FPS",
@@ -70,4 +62,4 @@ def test_parity_job_catches_a_wrong_gpu_decay_rate(built: dict[str, Path], tmp_p
     plan.write_text(text.replace(f'"decay": {decay!r}', f'"decay": {decay * 1.1!r}', 1))
     result = run_frost_parity(broken, groups=("history",))
     failed = [g["name"] for g in result.gates if g["status"] == "fail"]
-    assert any(name.startswith("GPU vs numpy history") for name in failed), describe(result.as_dict())
+    assert any(name.startswith("GPU vs numpy history") for name in failed), result.summary()

@@ -16,23 +16,13 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from conftest import EXAMPLES, REPO, run_cli
+from conftest import CREATURE_EXAMPLES, EXAMPLES, REPO, run_cli
 from creaturegen.rig import compile_rig
 from creaturegen.spec import CharacterSpec, load_spec
 from creaturegen.surface import build as surface_build
 from creaturegen.surface.asset import SurfaceCache, parse_glb
 from creaturegen.surface.build import SurfaceBuild, SurfaceRejectedError, build_surface
 
-CREATURES = [
-    "reference/biped.json",
-    "reference/flyer.json",
-    "reference/hexapod.json",
-    "reference/hopper.json",
-    "reference/quadruped.json",
-    "reference/swimmer.json",
-    "lizard.json",
-    "moth.json",
-]
 #: Parts the field itself leaves detached (rope or antenna anchored beyond the parent's surface).
 DETACHED = {
     "reference/quadruped.json": ("part.tail[0]",),
@@ -60,7 +50,7 @@ def cache_root(surface_cache_root: str) -> str:
     return surface_cache_root
 
 
-@pytest.mark.parametrize("name", CREATURES)
+@pytest.mark.parametrize("name", CREATURE_EXAMPLES)
 def test_every_gate_passes_and_the_asset_is_consistent(name: str, cache_root: str) -> None:
     built = _built(name, cache_root)
     failed = [g.name for g in built.gates if not g.passed]

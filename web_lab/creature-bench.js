@@ -5,6 +5,7 @@
 import * as THREE from 'three/webgpu';
 import { Fn, instanceIndex, instancedArray, int } from 'three/tsl';
 import { baselineFunctions, createBaselineMaterial } from './creature-baseline.js';
+import { countDraws } from './lab-common.js';
 
 const params = new URLSearchParams(location.search);
 const slug = params.get('pkg');
@@ -24,32 +25,8 @@ const out = document.getElementById('out');
 // Draw calls and render passes, counted at the WebGPU encoders (what was submitted, not what three meant to).
 // Each draw is charged to the pass encoder it was recorded on (three may begin one pass while another is
 // open on a different command encoder, e.g. the shadow map inside the main render).
-const draws = { passes: 0, perPass: [], instances: 0, passOf: new WeakMap() };
-{
-  const beginRenderPass = GPUCommandEncoder.prototype.beginRenderPass;
-  GPUCommandEncoder.prototype.beginRenderPass = function counted(...args) {
-    const pass = beginRenderPass.apply(this, args);
-    draws.passOf.set(pass, draws.perPass.length);
-    draws.passes += 1;
-    draws.perPass.push(0);
-    return pass;
-  };
-  const drawIndexed = GPURenderPassEncoder.prototype.drawIndexed;
-  GPURenderPassEncoder.prototype.drawIndexed = function counted(indexCount, instanceCount = 1, ...rest) {
-    const index = draws.passOf.get(this);
-    if (indexCount === draws.bodyIndexCount && index !== undefined && index < draws.perPass.length) {
-      draws.perPass[index] += 1;
-      draws.instances += instanceCount;
-    }
-    return drawIndexed.call(this, indexCount, instanceCount, ...rest);
-  };
-}
-function resetDraws() {
-  draws.passes = 0;
-  draws.perPass = [];
-  draws.instances = 0;
-  draws.passOf = new WeakMap();
-}
+const draws = countDraws();
+const resetDraws = () => draws.reset();
 
 // The smallest step performance.now() takes here (browsers coarsen it; spawn times are near it).
 function timerResolution() {

@@ -2,6 +2,7 @@
 // Playwright harness. Paused and deterministic by default: the pose moves only through seekTick/stepTicks.
 // Every GPU number it reports is read back from the device (buffers or render targets).
 import * as THREE from 'three/webgpu';
+import { countDeviceCalls, countDraws, fromBase64, toBase64 } from './lab-common.js';
 
 const params = new URLSearchParams(location.search);
 const slug = params.get('pkg');
@@ -12,29 +13,9 @@ const pageSize = Number(params.get('pageSize') ?? 64);
 const out = document.getElementById('out');
 
 // Count what the device creates, so "nothing created after reveal" is measured, not assumed.
-const deviceCounts = {};
-for (const name of ['createBuffer', 'createTexture', 'createBindGroup', 'createComputePipeline',
-  'createComputePipelineAsync', 'createRenderPipeline', 'createRenderPipelineAsync', 'createShaderModule']) {
-  deviceCounts[name] = 0;
-  const original = GPUDevice.prototype[name];
-  GPUDevice.prototype[name] = function counted(...args) {
-    deviceCounts[name] += 1;
-    return original.apply(this, args);
-  };
-}
-
-function toBase64(bytes) {
-  let text = '';
-  for (let i = 0; i < bytes.length; i += 0x8000) text += String.fromCharCode(...bytes.subarray(i, i + 0x8000));
-  return btoa(text);
-}
-
-function fromBase64(text) {
-  const bin = atob(text);
-  const bytes = new Uint8Array(bin.length);
-  for (let i = 0; i < bin.length; i++) bytes[i] = bin.charCodeAt(i);
-  return bytes;
-}
+const deviceCounts = countDeviceCalls();
+// Body draw calls per render pass, counted at the encoders: "one draw per page" is measured.
+const draws = countDraws();
 
 async function main() {
   if (!slug) throw new Error('creature lab: add ?pkg=<slug> (a folder of out/)');
@@ -51,6 +32,7 @@ async function main() {
   const pkg = await import(`/out/${slug}/index.js`);
   const data = pkg.CREATURE;
   const L = data.bodyScale;
+  draws.bodyIndexCount = 3 * data.mesh.triangles;
 
   // Scene: a ground plane that receives shadows, a shadow-casting sun straight above, a soft fill.
   const scene = new THREE.Scene();
@@ -190,7 +172,7 @@ async function main() {
     telemetry() {
       return {
         tick: pop.tick, count: pop.count, debugMode: pop.debugMode, stats: { ...pop.stats },
-        draws: pop.pages.filter((p) => p.mesh.count > 0).length, pages: pop.pages.length,
+        pagesInUse: pop.pages.filter((p) => p.mesh.count > 0).length, pages: pop.pages.length,
         instances: Array.from({ length: pop.count }, (_, i) => pop.instance(i)),
         variantKeys: pop.variantKeys(), errors: errors.length,
       };
@@ -236,7 +218,9 @@ async function main() {
       for (const [k, v] of Object.entries(deviceCounts)) after[k] = v - revealCounts[k];
       return { device: { ...deviceCounts }, sinceReveal: after };
     },
-    resetCounters() { Object.assign(revealCounts, deviceCounts); },
+    resetCounters() { Object.assign(revealCounts, deviceCounts); draws.reset(); },
+    /** Render passes and body draw calls per pass since the last resetCounters(), counted at the encoders. */
+    draws() { return { passes: draws.passes, perPass: [...draws.perPass], instances: draws.instances }; },
     spawnCost() {
       const sorted = [...spawnTimes].sort((a, b) => a - b);
       return { samples: sorted.length, medianMs: sorted.length ? sorted[Math.floor(sorted.length / 2)] : null, maxMs: sorted.at(-1) ?? null };

@@ -4,6 +4,7 @@
 // harness never calls it.)
 import * as THREE from 'three/webgpu';
 import { Fn, float, floor, mix, mod, uv, vec3 } from 'three/tsl';
+import { countDeviceCalls, toBase64 } from './lab-common.js';
 
 const params = new URLSearchParams(location.search);
 const slug = params.get('pkg');
@@ -12,16 +13,7 @@ const height = Number(params.get('h') ?? 160);
 const out = document.getElementById('out');
 
 // Count what the device creates, so "nothing created after reveal" is measured, not assumed.
-const deviceCounts = {};
-for (const name of ['createBuffer', 'createTexture', 'createBindGroup', 'createComputePipeline',
-  'createComputePipelineAsync', 'createRenderPipeline', 'createRenderPipelineAsync', 'createShaderModule']) {
-  deviceCounts[name] = 0;
-  const original = GPUDevice.prototype[name];
-  GPUDevice.prototype[name] = function counted(...args) {
-    deviceCounts[name] += 1;
-    return original.apply(this, args);
-  };
-}
+const deviceCounts = countDeviceCalls();
 
 function labScene() {
   // A deterministic, high-contrast backdrop so blur and refraction are visible in a readback.
@@ -42,12 +34,6 @@ function labScene() {
   const camera = new THREE.OrthographicCamera(-1, 1, 1, -1, 0.1, 10);
   camera.position.z = 2;
   return { scene, camera };
-}
-
-function toBase64(bytes) {
-  let text = '';
-  for (let i = 0; i < bytes.length; i += 0x8000) text += String.fromCharCode(...bytes.subarray(i, i + 0x8000));
-  return btoa(text);
 }
 
 async function main() {

@@ -298,13 +298,8 @@ def _parity(args: argparse.Namespace) -> int:
 def _lab(args: argparse.Namespace) -> int:
     from .lab import server
 
-    argv = ["--root", str(server_root()), "--out", args.out, "--host", args.host, "--port", str(args.port)]
+    argv = ["--root", str(server.WEB_LAB), "--out", args.out, "--host", args.host, "--port", str(args.port)]
     return server.main(argv)
-
-
-def server_root() -> Path:
-    """web_lab/ of this checkout (the lab is a static app beside the generator)."""
-    return Path(__file__).resolve().parents[2] / "web_lab"
 
 
 def build_parser() -> argparse.ArgumentParser:

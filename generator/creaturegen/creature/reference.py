@@ -7,7 +7,6 @@ package's JS or computed by the browser.
 
 from __future__ import annotations
 
-import json
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -37,7 +36,6 @@ class PackageReference:
     rig: CompiledRig
     sway: sway_module.Sway
     asset: SurfaceAsset
-    runtime: dict[str, object]
 
 
 def load_reference(package: Path) -> PackageReference:
@@ -47,15 +45,12 @@ def load_reference(package: Path) -> PackageReference:
         raise ValueError(f"{package}: assets/spec.json is not a creature spec")
     rig = compile_rig(spec)
     sway = sway_module.build_sway(rig, build_skeleton(spec, rig))
-    asset = read_glb(package / "assets" / "surface.glb")
-    text = (package / "core" / "data.js").read_text()
-    runtime = json.loads(text[text.index("Object.freeze(") + len("Object.freeze(") : text.rindex(");")])
-    return PackageReference(spec, rig, sway, asset, runtime)
+    return PackageReference(spec, rig, sway, read_glb(package / "assets" / "surface.glb"))
 
 
-def instance_transforms(ref: PackageReference, tick: int, seed: int) -> tuple[F64, F64]:
-    offset, _ = sway_module.instance_offset(seed)
-    return sway_module.sway_transforms(ref.sway, tick + offset)
+def instance_tick(tick: int, seed: int) -> int:
+    """The sway tick of an instance spawned from ``seed`` when the population is at ``tick``."""
+    return tick + sway_module.instance_offset(seed)[0]
 
 
 def field_at(ref: PackageReference, table: F64, points: F64) -> FieldSample:

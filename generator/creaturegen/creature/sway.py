@@ -165,12 +165,3 @@ def pose_rows(rig: CompiledRig, quats: F64, trans: F64) -> npt.NDArray[np.float3
     rows[:, 4, :3] = trans
     rows[:, 4, 3] = slot_uses_round_cone(slots)
     return rows.astype(np.float32)
-
-
-def posed_table(rig: CompiledRig, quats: F64, trans: F64) -> F64:
-    """The posed slot table in float64 (field/layout.py columns) for the numpy field reference."""
-    table = rig.slots.copy()
-    for s in range(rig.slot_count):
-        table[s, col.A] = _rotate(quats[s], rig.slots[s, col.A]) + trans[s]
-        table[s, col.B] = _rotate(quats[s], rig.slots[s, col.B]) + trans[s]
-    return table

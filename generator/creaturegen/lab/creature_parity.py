@@ -33,14 +33,12 @@ from scipy import ndimage
 
 from ..creature import reference as cref
 from ..creature import sway as sway_module
-from ..surface.deform import Pose, quaternion_to_matrix
+from ..surface.deform import posed_slots
 from .browser import launch_lab_page
-from .frost_parity import ParityReport
 from .png import write_png
-from .server import serve
+from .report import ParityReport
+from .server import WEB_LAB, serve
 
-REPO = Path(__file__).resolve().parents[3]
-WEB_LAB = REPO / "web_lab"
 DEFAULT_CANVAS = (192, 144)
 #: The pose tick the GPU gates run at (away from rest), and the seed of instance 0 (the lab's default).
 PARITY_TICK = 37
@@ -94,15 +92,31 @@ def _counter_gates(page: Page, report: ParityReport) -> None:
     report.gate(f"pipelines created by {SPAWNS} spawns after reveal", pipelines, 0, "pipelines")
     report.gate(f"buffers created by {SPAWNS} spawns after reveal", after["createBuffer"], 0, "buffers")
     telemetry = page.evaluate("() => window.__lab.telemetry()")
+    drawn = page.evaluate("() => window.__lab.draws()")
+    body_passes = [n for n in drawn["perPass"] if n > 0]
+    pages = telemetry["pagesInUse"]
+    report.gate(
+        "body draw calls per render pass minus pages in use (encoder count)",
+        float(max((abs(n - pages) for n in body_passes), default=pages)),
+        0,
+        "draws",
+    )
+    report.gate(
+        "render passes drawing the bodies (display + shadow)",
+        len(body_passes),
+        2,
+        "passes",
+        passed=len(body_passes) >= 2,
+    )
     report.measurements["population"] = {
         "count": telemetry["count"],
-        "draws": telemetry["draws"],
+        "pagesInUse": pages,
         "pages": telemetry["pages"],
+        "drawsPerPass": drawn["perPass"],
         "lastFrameBytes": telemetry["stats"]["lastFrameBytes"],
         "spawnCost": page.evaluate("() => window.__lab.spawnCost()"),
         "sinceReveal": after,
     }
-    report.gate("draws per frame == pages in use", telemetry["draws"], 1, "draws")
     page.evaluate("() => window.__lab.despawnAll([0])")
 
 
@@ -119,13 +133,15 @@ def _hash_gate(page: Page, report: ParityReport) -> None:
 
 def _pose_and_field_gates(page: Page, ref: cref.PackageReference, report: ParityReport) -> None:
     scale = ref.rig.body_scale
-    quats, trans = cref.instance_transforms(ref, PARITY_TICK, LAB_SEED)
+    quats, trans = sway_module.sway_transforms(ref.sway, cref.instance_tick(PARITY_TICK, LAB_SEED))
     gpu_rows = np.asarray(page.evaluate("() => window.__lab.readPose(0)"), dtype=np.float32)
     rows = sway_module.pose_rows(ref.rig, quats, trans).reshape(-1)
     report.gate(
         "pose rows: GPU vs Python", float(np.abs(gpu_rows[: rows.size] - rows).max()) / scale, 1e-6, "L"
     )
-    table = sway_module.posed_table(ref.rig, quats, trans)
+    table = posed_slots(
+        ref.rig.slots, sway_module.sway_pose(ref.sway, cref.instance_tick(PARITY_TICK, LAB_SEED))
+    )
     points = cref.probe_points(table, cref.blend_pairs(ref.rig), PROBE_POINTS)
     raw = page.evaluate("(p) => window.__lab.probeField(p)", points.reshape(-1).tolist())
     gpu = np.asarray(raw, dtype=np.float64).reshape(-1, 4)
@@ -155,11 +171,10 @@ def _pose_and_field_gates(page: Page, ref: cref.PackageReference, report: Parity
     }
 
 
-def _skin_gates(page: Page, ref: cref.PackageReference, table: F64, report: ParityReport) -> None:
+def _skin_gates(page: Page, ref: cref.PackageReference, report: ParityReport) -> None:
     scale = ref.rig.body_scale
-    quats, trans = cref.instance_transforms(ref, PARITY_TICK, LAB_SEED)
-    wxyz = np.concatenate([quats[:, 3:4], quats[:, :3]], axis=1)
-    pose = Pose(quaternion_to_matrix(wxyz), trans)
+    pose = sway_module.sway_pose(ref.sway, cref.instance_tick(PARITY_TICK, LAB_SEED))
+    table = posed_slots(ref.rig.slots, pose)
     got = page.evaluate("() => window.__lab.readSkinned(0)")
     skinned = _b64_floats(got["skinned"]).reshape(-1, 3).astype(np.float64)
     corrected = _b64_floats(got["corrected"]).reshape(-1, 3).astype(np.float64)
@@ -270,10 +285,8 @@ def run_creature_parity(
         phase("population", lambda: _counter_gates(page, report))
         phase("hash", lambda: _hash_gate(page, report))
         page.evaluate(f"() => window.__lab.seekTick({PARITY_TICK})")
-        quats, trans = cref.instance_transforms(ref, PARITY_TICK, LAB_SEED)
-        table = sway_module.posed_table(ref.rig, quats, trans)
         phase("field", lambda: _pose_and_field_gates(page, ref, report))
-        phase("skin", lambda: _skin_gates(page, ref, table, report))
+        phase("skin", lambda: _skin_gates(page, ref, report))
         phase("shadow", lambda: _shadow_gate(page, package, report))
         t = time.perf_counter()
         _pictures(page, package, debug_pictures)

@@ -24,9 +24,7 @@ import dataclasses
 import json
 from collections.abc import Iterator
 from contextlib import contextmanager
-from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
 
 import numpy as np
 import numpy.typing as npt
@@ -38,10 +36,9 @@ from ..frost.reference import STORAGE_OF_FORMAT, Storage, remap_bilinear
 from .browser import launch_lab_page
 from .frost_session import FrostLab
 from .png import write_png
-from .server import serve
+from .report import ParityReport
+from .server import WEB_LAB, serve
 
-REPO = Path(__file__).resolve().parents[3]
-WEB_LAB = REPO / "web_lab"
 DEFAULT_CANVAS = (160, 96)
 COMPOSITION_TOLERANCE = 1e-12
 #: 8-bit output codes allowed between the GPU's filtered sample and numpy's (sub-texel weight precision).
@@ -50,37 +47,6 @@ PIXEL_CODES = 3
 PICTURE_SLOWDOWN = 4
 
 Array = npt.NDArray[np.float64]
-
-
-@dataclass
-class ParityReport:
-    package: str
-    gates: list[dict[str, Any]] = field(default_factory=list)
-    measurements: dict[str, Any] = field(default_factory=dict)
-
-    def gate(self, name: str, value: float, threshold: float, unit: str, passed: bool | None = None) -> None:
-        ok = value <= threshold if passed is None else passed
-        self.gates.append(
-            {
-                "name": name,
-                "value": value,
-                "threshold": threshold,
-                "unit": unit,
-                "status": "pass" if ok else "fail",
-            }
-        )
-
-    @property
-    def passed(self) -> bool:
-        return all(g["status"] == "pass" for g in self.gates)
-
-    def as_dict(self) -> dict[str, Any]:
-        return {
-            "package": self.package,
-            "status": "pass" if self.passed else "fail",
-            "gates": self.gates,
-            "measurements": self.measurements,
-        }
 
 
 def reference_replay(params: FrostParams, size: tuple[int, int], fps: int, storage: Storage) -> Array:

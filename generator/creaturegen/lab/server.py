@@ -40,6 +40,8 @@ MIME_TYPES: dict[str, str] = {
     ".ico": "image/x-icon",
 }
 
+#: The lab app: static pages beside the generator, with three from its own node_modules.
+WEB_LAB = Path(__file__).resolve().parents[3] / "web_lab"
 DEFAULT_HOST = "127.0.0.1"
 DEFAULT_PORT = 8765
 

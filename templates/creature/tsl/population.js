@@ -96,7 +96,7 @@ export async function createCreaturePopulation(renderer, options = {}) {
   }
   const scratch = createPoseScratch(data.slotCount);
   const boxScratch = new Float64Array(6);
-  const sphere = new THREE.Sphere();
+  const corner = new THREE.Vector3();
   const box = new THREE.Box3();
   let tick = 0;
   let mode = options.debugMode ?? 'off';
@@ -144,8 +144,8 @@ export async function createCreaturePopulation(renderer, options = {}) {
       if (!page.alive[j]) continue;
       last = j;
       const b = page.bounds;
-      box.expandByPoint(sphere.center.set(b[6 * j], b[6 * j + 1], b[6 * j + 2]));
-      box.expandByPoint(sphere.center.set(b[6 * j + 3], b[6 * j + 4], b[6 * j + 5]));
+      box.expandByPoint(corner.set(b[6 * j], b[6 * j + 1], b[6 * j + 2]));
+      box.expandByPoint(corner.set(b[6 * j + 3], b[6 * j + 4], b[6 * j + 5]));
     }
     page.mesh.count = last + 1;
     if (last < 0) page.mesh.boundingSphere.set(page.mesh.boundingSphere.center.set(0, 0, 0), 0);
@@ -226,8 +226,8 @@ export async function createCreaturePopulation(renderer, options = {}) {
     },
     /** Advance whole ticks (the sway is closed form, so this equals seekTick(tick + n)). */
     stepTicks(n = 1) {
-      for (let k = 0; k < n; k++) { tick += 1; stats.ticks += 1; }
-      setTick(tick);
+      stats.ticks += n;
+      setTick(tick + n);
       return flush();
     },
     seekTick(n) {
@@ -253,14 +253,7 @@ export async function createCreaturePopulation(renderer, options = {}) {
       return page.staging.slice(j * floatsPerInstance, (j + 1) * floatsPerInstance);
     },
     stateHash() {
-      const parts = [];
-      for (const page of pages) parts.push(new Uint8Array(page.staging.buffer, page.staging.byteOffset, page.staging.byteLength));
-      let total = 0;
-      for (const p of parts) total += p.length;
-      const all = new Uint8Array(total);
-      let o = 0;
-      for (const p of parts) { all.set(p, o); o += p.length; }
-      return hashBytes(all, tick);
+      return hashBytes(pages.map((p) => new Uint8Array(p.staging.buffer, p.staging.byteOffset, p.staging.byteLength)), tick);
     },
     setDebugMode(m) {
       for (const page of pages) page.mesh.material = materialFor(page, m);

@@ -71,7 +71,7 @@ export const DEBUG_MODES: readonly DebugMode[];
 /** Requires an initialised WebGPURenderer on a WebGPU backend; throws otherwise. */
 export function createCreaturePopulation(renderer: WebGPURenderer, options?: PopulationOptions): Promise<CreaturePopulation>;
 export function createDiagnostics(renderer: WebGPURenderer, population: CreaturePopulation, options?: { maxPoints?: number }): CreatureDiagnostics;
-export function hashBytes(bytes: Uint8Array, tick: number): string;
+export function hashBytes(bytes: Uint8Array | Uint8Array[], tick: number): string;
 export function instanceOffset(seed: number, lcg: { a: number; c: number }, period: number): { tickOffset: number; yaw: number };
 export function lcgNext(state: number, a: number, c: number): number;
 export function parseGlb(buffer: ArrayBuffer): { attributes: Record<string, { array: Float32Array | Uint16Array | Uint32Array; itemSize: number }>; index: { array: Uint16Array | Uint32Array }; extras: Record<string, unknown> };

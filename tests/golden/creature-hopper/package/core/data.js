@@ -2959,7 +2959,7 @@ export const CREATURE = Object.freeze({
     0
   ],
   "signatures": {
-    "compilerSignature": "c671be41ce2b7b228800302e2dead9f6b10c3923b38e4eb70b89ea8f171be563",
+    "compilerSignature": "908ab0d9915c5d35e8f5bfc2d52bb0df0506a59fc1bb273aaea89ce34e2aec2c",
     "geometryDigest": "400b0d18a2a9f6bbbfe5b441f89767f552a4f3b4c45a368d1129d632e1d2f4f1",
     "topologySignature": "d997bf5a05460ff68faead98d301d8766cd723bba06ded7b59f9e73102ccda75"
   },

@@ -47,7 +47,7 @@ export function swayTransforms(data, tick, scratch) {
     rotate(local, 0, pv[0], pv[1], pv[2], tmp, 0);
     // q_s = q_p ⊗ local
     const px = quats[4 * p], py = quats[4 * p + 1], pz = quats[4 * p + 2], pw = quats[4 * p + 3];
-    const [bx, by, bz, bw] = [local[0], local[1], local[2], local[3]];
+    const bx = local[0], by = local[1], bz = local[2], bw = local[3];
     quats[4 * s] = pw * bx + px * bw + py * bz - pz * by;
     quats[4 * s + 1] = pw * by - px * bz + py * bw + pz * bx;
     quats[4 * s + 2] = pw * bz + px * by - py * bx + pz * bw;

@@ -1,0 +1,43 @@
+"""The parity report every parity job writes: gates with measured value, threshold, unit and status."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Any
+
+
+@dataclass
+class ParityReport:
+    package: str
+    gates: list[dict[str, Any]] = field(default_factory=list)
+    measurements: dict[str, Any] = field(default_factory=dict)
+
+    def gate(self, name: str, value: float, threshold: float, unit: str, passed: bool | None = None) -> None:
+        ok = value <= threshold if passed is None else passed
+        self.gates.append(
+            {
+                "name": name,
+                "value": value,
+                "threshold": threshold,
+                "unit": unit,
+                "status": "pass" if ok else "fail",
+            }
+        )
+
+    @property
+    def passed(self) -> bool:
+        return all(g["status"] == "pass" for g in self.gates)
+
+    def summary(self) -> str:
+        """One line per gate, for error messages and logs."""
+        return "\n".join(
+            f"{g['status']:4} {g['name']}: {g['value']} (<= {g['threshold']} {g['unit']})" for g in self.gates
+        )
+
+    def as_dict(self) -> dict[str, Any]:
+        return {
+            "package": self.package,
+            "status": "pass" if self.passed else "fail",
+            "gates": self.gates,
+            "measurements": self.measurements,
+        }
