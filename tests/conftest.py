@@ -51,6 +51,19 @@ def surface_cache_root(tmp_path_factory: pytest.TempPathFactory) -> Iterator[str
         os.environ["CREATUREGEN_CACHE"] = previous
 
 
+@pytest.fixture(scope="session", autouse=True)
+def no_build_pictures() -> Iterator[None]:
+    """Builds in tests skip the README picture (a Chromium launch each) through $CREATUREGEN_PICTURE;
+    test_creature_picture.py asks for it explicitly with --picture on."""
+    previous = os.environ.get("CREATUREGEN_PICTURE")
+    os.environ["CREATUREGEN_PICTURE"] = "off"
+    yield
+    if previous is None:
+        os.environ.pop("CREATUREGEN_PICTURE", None)
+    else:
+        os.environ["CREATUREGEN_PICTURE"] = previous
+
+
 def run_cli(*args: str, cwd: Path = REPO) -> subprocess.CompletedProcess[str]:
     """The installed command line in a child process, as a user runs it."""
     return subprocess.run(

@@ -190,6 +190,16 @@ def test_lint_finds_nothing_in_the_package(hopper: Path) -> None:
     assert findings == [], "\n".join(map(str, findings))
 
 
+def test_deform_storage_layout_is_one_definition_in_python_and_js(hopper: Path) -> None:
+    """The build report's deformBytesPerBody and the runtime's page clamp use the same stride."""
+    from creaturegen.creature.plan import DEFORM_STRIDE
+
+    js = (hopper / "tsl" / "deform.js").read_text()
+    assert f"export const DEFORM_STRIDE = {DEFORM_STRIDE};" in js
+    workload = json.loads((hopper / "build-report.json").read_text())["workload"]
+    assert workload["deformBytesPerBody"] == workload["vertices"] * DEFORM_STRIDE * 16
+
+
 #: (rule, snippet): each must be found, at the line it starts on.
 PLANTED = [
     ("nondeterminism", "const r = Math.random();"),

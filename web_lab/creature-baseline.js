@@ -6,15 +6,13 @@
 //   tape runs over the precomputed distances, so the value equals the shipped field's;
 // * normals and Newton steps: 6-tap central differences, i.e. six extra full evaluations per field query.
 //
-// The body path around it is the package's own: skinning (createSkin), the bounded correction (createSkin's
-// correctVertex, handed this field instead of the analytic one, so the trial logic and its depth are the
-// same), bodyVertex, the colour (the shipped programColour), the root transform. Per field query the
+// The body path around it is the package's own: the deform pre-pass (createDeformKernel), skinning
+// (createSkin), the bounded correction (createSkin's correctVertex, handed this field instead of the analytic
+// one, so the trial logic and its depth are the same), bodyVertex, the material, the root transform. Per field query the
 // baseline evaluates 7·P slot distances where the shipped path runs one K-instruction tape that carries
 // distance and gradient together: the seed's ratio 7P/K at equal depth.
-import * as THREE from 'three/webgpu';
 import {
-  Fn, If, Loop, abs, array, attribute, clamp, exp, float, instanceIndex, int, log, max, min, normalLocal,
-  normalize, positionGeometry, select, sqrt, varyingProperty, vec3, vec4,
+  Fn, If, Loop, abs, array, clamp, exp, float, int, log, max, min, select, sqrt, vec3, vec4,
 } from 'three/tsl';
 
 const dot3 = (u, v) => u.x.mul(v.x).add(u.y.mul(v.y)).add(u.z.mul(v.z));
@@ -124,39 +122,32 @@ export function createBaselineField(tsl, layout, pose, programs, step) {
   return { distance, runProgram };
 }
 
-/** The baseline's field and skin builders over one pose page (shipped skin, baseline field). */
+/**
+ * The baseline's field and skin builders over one pose page: the shipped skin and correction logic over the
+ * baseline field, whose `evaluate` (the final per-vertex evaluation: distance and normal) is the masked
+ * full-budget unroll with central differences too. The baseline skips the albedo blend (a constant grey),
+ * which only makes it cheaper: the measured ratio understates the shipped path's advantage.
+ */
 export function baselineFunctions(tsl, layout, pose, programs, step) {
   const shipped = tsl.bodyFunctions(layout, pose, programs);
   const baseline = createBaselineField(tsl, layout, pose, programs, step);
-  const field = { ...shipped.field, runProgram: baseline.runProgram, distance: baseline.distance };
+  const evaluate = (p, base, program, { colour = false } = {}) => ({
+    value: baseline.runProgram(p, base, program).toVar(),
+    colour: colour ? vec3(0.6) : null,
+  });
+  const field = { ...shipped.field, evaluate, runProgram: baseline.runProgram, distance: baseline.distance };
   const skin = tsl.createSkin({ pose, rows: layout.rows, field, correction: layout.correction });
   return { field, skin, shipped };
 }
 
 /**
- * The baseline display material of one page: the shipped material's 'off' variant (createBodyMaterial) with
- * the baseline field in the correction and the normal.
+ * The baseline deform pre-pass of one page: the package's own createDeformKernel (same dispatch, same
+ * storage, same material reading it) over the baseline functions. Swapping `page.kernel` between this and
+ * the shipped kernel changes nothing but the field path.
  */
-export function createBaselineMaterial(tsl, layout, pose, programs, step) {
-  const fns = baselineFunctions(tsl, layout, pose, programs, step);
-  const material = new THREE.MeshStandardNodeMaterial({ roughness: 0.55, metalness: 0.0 });
-  const vColour = varyingProperty('vec3', 'vCgColour');
-  material.positionNode = Fn(() => {
-    const base = int(instanceIndex).mul(layout.maxParts * layout.rows).toVar();
-    const rootRow = base.add(layout.slotCount * layout.rows);
-    const root0 = pose.element(rootRow).toVar();
-    const root1 = pose.element(rootRow.add(1)).toVar();
-    const body = tsl.bodyVertex(layout, fns, {
-      rest: positionGeometry, slots: attribute('cgSlots', 'vec4'), weights: attribute('cgWeights', 'vec4'),
-      skin: attribute('cgSkin', 'vec4'), cor: attribute('cgCor', 'vec3'), base, skinOnly: false,
-    });
-    const p = body.position.toVar();
-    const n = normalize(body.gradient).toVar();
-    vColour.assign(fns.field.programColour(p, base, body.program, layout.kFloor));
-    const rot = (v) => vec3(root1.x.mul(v.x).add(root1.y.mul(v.z)), v.y, root1.y.negate().mul(v.x).add(root1.x.mul(v.z)));
-    normalLocal.assign(rot(n));
-    return select(root0.w.greaterThan(0.5), rot(p).add(root0.xyz), vec3(0));
-  })();
-  material.colorNode = vColour;
-  return material;
+export function createBaselineKernel(tsl, layout, page, records, programs, step) {
+  const fns = baselineFunctions(tsl, layout, page.pose, programs, step);
+  return tsl.createDeformKernel(layout, fns, {
+    pose: page.pose, records, deform: page.deform, size: page.size, vertices: layout.vertices,
+  });
 }

@@ -138,12 +138,27 @@ async function main() {
 
   async function capturePixels(view = 'front') {
     if (view === 'front') return { view, width, height, rgba: toBase64(await renderTo(camera, width, height)) };
+    if (view === 'portrait') {
+      // Three-quarter view framing body 0's posed bounds (the package README's picture).
+      const b = pop.instance(0).bounds;
+      const centre = new THREE.Vector3((b[0] + b[3]) / 2, (b[1] + b[4]) / 2, (b[2] + b[5]) / 2);
+      const radius = 0.5 * Math.hypot(b[3] - b[0], b[4] - b[1], b[5] - b[2]);
+      const cam = camera.clone();
+      const distance = 1.15 * radius / Math.sin(THREE.MathUtils.degToRad(cam.fov / 2));
+      cam.position.copy(centre).add(new THREE.Vector3(0.62, 0.42, 0.66).normalize().multiplyScalar(distance));
+      cam.near = 0.01 * distance;
+      cam.far = 10 * distance;
+      cam.lookAt(centre);
+      cam.updateProjectionMatrix();
+      cam.updateMatrixWorld();
+      return { view, width, height, rgba: toBase64(await renderTo(cam, width, height)) };
+    }
     if (view === 'top') {
       const cam = sun.shadow.camera.clone();
       cam.position.copy(sun.position); cam.lookAt(0, 0, 0); cam.updateMatrixWorld();
       return { view, width: 128, height: 128, rgba: toBase64(await renderTo(cam, 128, 128)) };
     }
-    throw new Error(`capturePixels: view is front or top (got ${view})`);
+    throw new Error(`capturePixels: view is front, portrait or top (got ${view})`);
   }
 
   const spawnTimes = [];
@@ -161,7 +176,7 @@ async function main() {
         limits: { maxStorageBuffersPerShaderStage: device.limits.maxStorageBuffersPerShaderStage, maxStorageBufferBindingSize: device.limits.maxStorageBufferBindingSize },
         features: [...device.features].sort(),
         tier: data.tier, slots: data.slotCount, registers: data.registers, programs: data.programCount,
-        vertices: data.mesh.vertices, triangles: data.mesh.triangles, capacity, pageSize, pages: pop.pages.length,
+        vertices: data.mesh.vertices, triangles: data.mesh.triangles, capacity, pageSize: pop.pageSize, pages: pop.pages.length,
         signatures: data.signatures, bodyScale: L, canvas: [width, height], lift,
       };
     },
@@ -209,6 +224,12 @@ async function main() {
         accepted: toBase64(new Uint8Array(r.accepted.buffer)), gradient: toBase64(new Uint8Array(r.gradient.buffer)),
         distance: toBase64(new Uint8Array(r.distance.buffer)) };
     },
+    /** What the display and shadow passes draw (the page's deform storage), read back. */
+    async readDeformed(i = 0) {
+      const r = await diag.readDeformed(i);
+      return { position: toBase64(new Uint8Array(r.position.buffer)), gradient: toBase64(new Uint8Array(r.gradient.buffer)),
+        distance: toBase64(new Uint8Array(r.distance.buffer)), accepted: toBase64(new Uint8Array(r.accepted.buffer)) };
+    },
     capturePixels,
     shadowParity,
     render,
@@ -235,7 +256,13 @@ async function main() {
 function wireControls(lab, modes) {
   const select = document.getElementById('mode');
   for (const m of modes) select.add(new Option(m, m));
-  select.onchange = () => { try { lab.setDebugMode(select.value); } catch (e) { out.textContent = String(e); } };
+  const note = document.getElementById('mode-note');
+  select.onchange = () => {
+    try {
+      lab.setDebugMode(select.value);
+      note.textContent = select.value === 'shell' ? 'diagnostic capsule shell (pose storage), not the shipping body' : '';
+    } catch (e) { out.textContent = String(e); }
+  };
   document.getElementById('step').onclick = () => lab.stepTicks(1);
   document.getElementById('grid').onclick = () => lab.spawn(100, 63);
   let playing = false;

@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import os
 import re
 import sys
 from collections.abc import Sequence
@@ -18,6 +19,7 @@ import numpy as np
 from . import __version__
 from .candidates import TIERS, describe_candidates
 from .creature.build import build_creature
+from .creature.picture import PICTURE_PATH, picture_unavailable
 from .emit import PackageWriteError
 from .field.sampler import sample
 from .frost.build import build_frost
@@ -154,11 +156,25 @@ def _build_creature(args: argparse.Namespace, spec: CharacterSpec, data: bytes) 
     counts = build.sidecar["counts"]
     print(f"  mesh {counts}; " + ("cache hit" if build.cached else "extracted"))
     print("==> package: candidate program tapes, sway pose, templates")
+    picture = args.picture == "on"
+    if args.picture == "auto":
+        reason = picture_unavailable()
+        picture = reason is None
+        if reason is not None:
+            print(f"  no README picture: the lab cannot run here ({reason}); --picture off to silence this")
+    if picture:
+        print(f"==> picture: {PICTURE_PATH} rendered by the lab (headless Chromium, WebGPU on SwiftShader)")
     try:
-        folder = build_creature(spec, rig, data, build, Path(args.out))
+        folder = build_creature(spec, rig, data, build, Path(args.out), picture=picture)
     except PackageWriteError as exc:
         print(f"{args.spec}: cannot write the package: {exc}", file=sys.stderr)
         return EXIT_INVALID
+    except RuntimeError as exc:
+        if not picture:
+            raise
+        print(f"{args.spec}: cannot render the README picture ({exc}); nothing was written.", file=sys.stderr)
+        print("  build without it: --picture off", file=sys.stderr)
+        return EXIT_GATE_FAILED
     print(f"wrote {folder}/")
     return EXIT_OK
 
@@ -359,6 +375,13 @@ def build_parser() -> argparse.ArgumentParser:
         default="auto",
         choices=("auto", *BACKENDS),
         help="surface sampling backend: auto (the faster, measured), numpy or wgpu",
+    )
+    build.add_argument(
+        "--picture",
+        default=os.environ.get("CREATUREGEN_PICTURE", "auto"),
+        choices=("auto", "on", "off"),
+        help="creature packages: render the README picture in the lab before committing the package "
+        "(auto: when Chromium and web_lab/node_modules are there; default $CREATUREGEN_PICTURE or auto)",
     )
     build.set_defaults(run=_build)
 

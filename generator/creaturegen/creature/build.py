@@ -13,6 +13,7 @@ from ..spec import CharacterSpec, slugify
 from ..surface.asset import glb_bytes, sidecar_bytes
 from ..surface.build import SurfaceBuild
 from ..surface.emit import stable_sidecar
+from .picture import PICTURE_PATH, render_picture
 from .plan import build_plan
 
 
@@ -36,11 +37,12 @@ def build_report(plan: dict[str, Any], surface: SurfaceBuild) -> dict[str, Any]:
 
 
 def creature_files(
-    spec: CharacterSpec, rig: CompiledRig, spec_bytes: bytes, surface: SurfaceBuild
+    spec: CharacterSpec, rig: CompiledRig, spec_bytes: bytes, surface: SurfaceBuild, picture: bool = False
 ) -> list[PackageFile]:
+    """Every file of the package but the picture; with ``picture`` the README shows PICTURE_PATH."""
     spec_sha256 = hashlib.sha256(spec_bytes).hexdigest()
     built = build_plan(spec, rig, surface, spec_sha256)
-    plan = built.plan
+    plan = {**built.plan, "picture": PICTURE_PATH if picture else None}
     files = render_folder("creature", plan, spec_sha256)
     # The exact spec bytes: the parity job rebuilds the Python reference (rig, field, skeleton) from them.
     files.append(PackageFile("assets/spec.json", spec_bytes))
@@ -52,7 +54,18 @@ def creature_files(
 
 
 def build_creature(
-    spec: CharacterSpec, rig: CompiledRig, spec_bytes: bytes, surface: SurfaceBuild, out_root: Path
+    spec: CharacterSpec,
+    rig: CompiledRig,
+    spec_bytes: bytes,
+    surface: SurfaceBuild,
+    out_root: Path,
+    picture: bool = False,
 ) -> Path:
-    """Write the package and return its folder. Nothing is written if any step raises."""
-    return write_package(out_root, slugify(spec.name), creature_files(spec, rig, spec_bytes, surface))
+    """Write the package and return its folder. With ``picture`` the staged package is rendered by the lab
+    into PICTURE_PATH before it is committed. Nothing is written if any step raises."""
+    files = creature_files(spec, rig, spec_bytes, surface, picture)
+
+    def add_picture(staging: Path) -> list[PackageFile]:
+        return [PackageFile(PICTURE_PATH, render_picture(staging))]
+
+    return write_package(out_root, slugify(spec.name), files, add_picture if picture else None)

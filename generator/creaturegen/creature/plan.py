@@ -27,6 +27,8 @@ from .tape import Tape, compile_tape
 
 #: The runtime's debug views (lab `setDebugMode`); "shell" is the diagnostic capsule shell.
 DEBUG_MODES = ("off", "skin-only", "distance", "weights", "normals", "candidates", "shell")
+#: vec4 per vertex in a page's deform storage (templates/creature/tsl/deform.js DEFORM_STRIDE).
+DEFORM_STRIDE = 3
 
 
 @dataclass(frozen=True)
@@ -133,6 +135,8 @@ def build_plan(
             "triangles": runtime["mesh"]["triangles"],
             "correctedVertices": corrected,
             "poseBytesPerBody": runtime["maxParts"] * sway_module.POSE_ROWS * 16,
+            # The deform pre-pass storage (tsl/deform.js DEFORM_STRIDE vec4 per vertex).
+            "deformBytesPerBody": asset.vertex_count * DEFORM_STRIDE * 16,
         },
         "methods": {m: int(np.count_nonzero(skin[:, 0] == i)) for i, m in enumerate(METHODS)},
     }

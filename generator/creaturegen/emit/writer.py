@@ -12,6 +12,7 @@ from __future__ import annotations
 import os
 import shutil
 import tempfile
+from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path, PurePosixPath
 
@@ -61,8 +62,25 @@ def _remove(path: Path) -> None:
         path.unlink()
 
 
-def write_package(out_root: Path, slug: str, files: list[PackageFile]) -> Path:
-    """Write ``files`` to ``out_root/slug`` atomically; returns the package folder."""
+def _write_files(root: Path, files: list[PackageFile]) -> None:
+    for item in sorted(files, key=lambda f: f.path):
+        target = _safe_target(root, item.path)
+        target.parent.mkdir(parents=True, exist_ok=True)
+        target.write_bytes(item.content)
+        os.chmod(target, 0o644)
+
+
+def write_package(
+    out_root: Path,
+    slug: str,
+    files: list[PackageFile],
+    finish: Callable[[Path], list[PackageFile]] | None = None,
+) -> Path:
+    """Write ``files`` to ``out_root/slug`` atomically; returns the package folder.
+
+    ``finish`` runs on the complete staging folder before it is committed and returns more files to add
+    (the README picture is rendered from the package itself); if it raises, nothing is written.
+    """
     if not slug or "/" in slug or slug in {".", ".."}:
         raise PackageWriteError(f"invalid package folder name {slug!r}")
     out_root.mkdir(parents=True, exist_ok=True)
@@ -71,11 +89,9 @@ def write_package(out_root: Path, slug: str, files: list[PackageFile]) -> Path:
         raise PackageWriteError(f"{final} exists and is not a folder; refusing to replace it")
     staging = Path(tempfile.mkdtemp(prefix=f".{slug}.", suffix=".tmp", dir=out_root))
     try:
-        for item in sorted(files, key=lambda f: f.path):
-            target = _safe_target(staging, item.path)
-            target.parent.mkdir(parents=True, exist_ok=True)
-            target.write_bytes(item.content)
-            os.chmod(target, 0o644)
+        _write_files(staging, files)
+        if finish is not None:
+            _write_files(staging, finish(staging))
         for folder in [staging, *(p for p in staging.rglob("*") if p.is_dir())]:
             os.chmod(folder, 0o755)
         backup = None

@@ -196,6 +196,22 @@ def _skin_gates(page: Page, ref: cref.PackageReference, report: ParityReport) ->
     report.gate(
         "corrections outside the region policy", float(np.count_nonzero(accepted & ~region)), 0, "vertices"
     )
+    # What the passes draw (the page's deform storage, written by the pre-pass) against the same body path
+    # run by the diagnostics kernel: a wrong index, range or stale pose in the pre-pass shows up here.
+    drawn = page.evaluate("() => window.__lab.readDeformed(0)")
+    drawn_position = _b64_floats(drawn["position"]).reshape(-1, 3).astype(np.float64)
+    drawn_error = np.linalg.norm(drawn_position - corrected, axis=1) / scale
+    report.gate(
+        "drawn vertices (deform storage) vs the GPU body path", float(drawn_error.max()), POSITION_TOL, "L"
+    )
+    drawn_distance = _b64_floats(drawn["distance"]).astype(np.float64)
+    at_drawn = cref.field_at(ref, table, drawn_position)
+    report.gate(
+        "drawn field distance vs numpy at the drawn vertices",
+        float(np.abs(drawn_distance - at_drawn.distance).max() / scale),
+        DISTANCE_TOL,
+        "L",
+    )
     report.measurements["correction"] = {
         "region": int(region.sum()),
         "accepted": int(accepted.sum()),
@@ -247,7 +263,7 @@ def _pictures(page: Page, package: Path, debug: bool) -> None:
     write_png(
         package / "parity" / "front.png", _rgba(page.evaluate("() => window.__lab.capturePixels('front')"))
     )
-    for mode in ("distance", "normals", "candidates") if debug else ():
+    for mode in ("distance", "normals", "candidates", "shell") if debug else ():
         page.evaluate(f"() => window.__lab.setDebugMode('{mode}')")
         shot = page.evaluate("() => window.__lab.capturePixels('front')")
         write_png(package / "parity" / f"debug-{mode}.png", _rgba(shot))

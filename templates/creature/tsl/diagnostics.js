@@ -2,13 +2,8 @@
 // the material (field programs, skinning, correction), with results read back from the GPU. Kernels and
 // their buffers are created on first use, never by spawn or render.
 import { Fn, instanceIndex, instancedArray, int, uniform, vec4 } from 'three/tsl';
-import { bodyFunctions, bodyVertex } from './material.js';
-
-function vec4Array(source, itemSize, count) {
-  const out = new Float32Array(4 * count);
-  for (let i = 0; i < count; i++) for (let c = 0; c < itemSize; c++) out[4 * i + c] = source[itemSize * i + c];
-  return out;
-}
+import { bodyFunctions, bodyVertex } from './body.js';
+import { DEFORM_STRIDE, recordInputs } from './deform.js';
 
 export function createDiagnostics(renderer, population, { maxPoints = 8192 } = {}) {
   const { layout, programs, geometry, pages } = population;
@@ -19,12 +14,6 @@ export function createDiagnostics(renderer, population, { maxPoints = 8192 } = {
 
   function skinKernels() {
     if (skinState) return skinState;
-    const a = geometry.attributes;
-    const vA = instancedArray(vec4Array(a.position.array, 3, n), 'vec4').toReadOnly();
-    const vB = instancedArray(new Float32Array(a.cgSlots.array), 'vec4').toReadOnly();
-    const vC = instancedArray(new Float32Array(a.cgWeights.array), 'vec4').toReadOnly();
-    const vD = instancedArray(vec4Array(a.cgCor.array, 3, n), 'vec4').toReadOnly();
-    const vM = instancedArray(new Float32Array(a.cgSkin.array), 'vec4').toReadOnly();
     const out = instancedArray(3 * n, 'vec4');
     const instance = uniform(0, 'int');
     const kernels = pages.map((page) => {
@@ -32,10 +21,7 @@ export function createDiagnostics(renderer, population, { maxPoints = 8192 } = {
       return Fn(() => {
         const i = int(instanceIndex);
         const base = instance.mul(rowsPerInstance).toVar();
-        const body = bodyVertex(layout, fns, {
-          rest: vA.element(i).xyz, slots: vB.element(i), weights: vC.element(i), skin: vM.element(i),
-          cor: vD.element(i).xyz, base, skinOnly: false,
-        });
+        const body = bodyVertex(layout, fns, { ...recordInputs(population.records, i), base, skinOnly: false });
         out.element(i.mul(3)).assign(vec4(body.skinned, 0));
         out.element(i.mul(3).add(1)).assign(vec4(body.position, body.accepted));
         out.element(i.mul(3).add(2)).assign(vec4(body.gradient, body.distance));
@@ -103,6 +89,29 @@ export function createDiagnostics(renderer, population, { maxPoints = 8192 } = {
       renderer.compute(s.kernels[pages.indexOf(page)]);
       const raw = new Float32Array(await renderer.getArrayBufferAsync(s.out.value));
       return raw.slice(0, 4 * count);
+    },
+    /**
+     * What the passes draw for instance `id`: its page's deform storage read back (creature-local, before
+     * the root transform): { position, gradient, distance, accepted, colour, program } as Float32Arrays.
+     */
+    async readDeformed(id) {
+      const { page, index } = population.locate(id);
+      const floats = 4 * DEFORM_STRIDE * n;
+      const raw = new Float32Array(await renderer.getArrayBufferAsync(page.deform.value, null, 4 * floats * index, 4 * floats));
+      const position = new Float32Array(3 * n), gradient = new Float32Array(3 * n), colour = new Float32Array(3 * n);
+      const distance = new Float32Array(n), accepted = new Float32Array(n), program = new Float32Array(n);
+      for (let v = 0; v < n; v++) {
+        const o = 4 * DEFORM_STRIDE * v;
+        for (let c = 0; c < 3; c++) {
+          position[3 * v + c] = raw[o + c];
+          gradient[3 * v + c] = raw[o + 4 + c];
+          colour[3 * v + c] = raw[o + 8 + c];
+        }
+        distance[v] = raw[o + 3];
+        accepted[v] = raw[o + 7];
+        program[v] = raw[o + 11];
+      }
+      return { position, gradient, distance, accepted, colour, program };
     },
     /** The pose rows of instance `id` as the GPU holds them (readback). */
     async readPose(id) {

@@ -1,6 +1,12 @@
-// Three/TSL adapter: pose pages, field programs, skinning, materials, population, diagnostics.
+// Three/TSL adapter: pose pages, field programs, skinning, the deform pre-pass, materials, population,
+// the diagnostic shell, diagnostics.
 export { OP, createField } from './field.js';
 export { METHOD, createSkin, rotate } from './skin.js';
-export { DEBUG_MODES, bodyFunctions, bodyVertex, createBodyMaterial, layoutOf } from './material.js';
+export { bodyFunctions, bodyVertex, layoutOf } from './body.js';
+export {
+  DEFORM_STRIDE, RECORD_STRIDE, createDeformKernel, deformStorage, deformView, dispatchDeform, recordInputs, vertexRecords,
+} from './deform.js';
+export { DEBUG_MODES, createBodyMaterial, hashColour, rootRotate } from './material.js';
+export { createShellMesh } from './shell.js';
 export { assertWebGPU, createCreaturePopulation, programStorage, surfaceGeometry } from './population.js';
 export { createDiagnostics } from './diagnostics.js';

@@ -1,7 +1,7 @@
 // A population of one creature: fixed-capacity pose pages (vec4 storage, CPU Float32Array staging),
-// one material and one draw per page, coalesced dirty-range uploads, posed bounds per page, spawn as
-// validation plus an O(slots) write. Nothing is created after `ready` resolves: pages, materials and
-// pipelines are built and compileAsync-warmed up front.
+// one deform pre-pass, one material and one draw per page, coalesced dirty-range uploads, posed bounds
+// per page, spawn as validation plus an O(slots) write. Nothing is created after warm(): pages, deform
+// storage, materials and pipelines (compute, display, shadow) are built and warmed up front.
 import * as THREE from 'three/webgpu';
 import { instancedArray } from 'three/tsl';
 import { CREATURE } from '../core/data.js';
@@ -9,7 +9,12 @@ import { parseGlb } from '../core/glb.js';
 import { hashBytes } from '../core/hash.js';
 import { instanceOffset } from '../core/lcg.js';
 import { createPoseScratch, swayTransforms, writePoseRows } from '../core/pose.js';
-import { DEBUG_MODES, createBodyMaterial, layoutOf } from './material.js';
+import { bodyFunctions, layoutOf } from './body.js';
+import {
+  DEFORM_STRIDE, createDeformKernel, deformStorage, deformView, dispatchDeform, vertexRecords,
+} from './deform.js';
+import { DEBUG_MODES, createBodyMaterial } from './material.js';
+import { createShellMesh } from './shell.js';
 
 const SHIPPED_VARIANTS = ['off'];
 
@@ -55,26 +60,42 @@ async function loadSurface(url) {
 
 /**
  * Create a population. Options: capacity (bodies, default 64), pageSize (bodies per page and draw,
+ * at most what one storage binding of the device holds: DEFORM_STRIDE·16 bytes per vertex per body,
  * default 64), tier (the built tier only), debugMode, surfaceUrl (default: this package's asset).
  */
 export async function createCreaturePopulation(renderer, options = {}) {
   assertWebGPU(renderer);
   const data = CREATURE;
   const capacity = options.capacity ?? 64;
-  const pageSize = Math.min(options.pageSize ?? 64, capacity);
+  const requestedPageSize = options.pageSize ?? 64;
   if (!Number.isInteger(capacity) || capacity < 1) throw new Error(`capacity: must be a positive integer (got ${capacity})`);
-  if (!Number.isInteger(pageSize) || pageSize < 1) throw new Error(`pageSize: must be a positive integer (got ${pageSize})`);
+  if (!Number.isInteger(requestedPageSize) || requestedPageSize < 1) {
+    throw new Error(`pageSize: must be a positive integer (got ${requestedPageSize})`);
+  }
   const tier = options.tier ?? data.tier;
   if (tier !== data.tier) throw new Error(`tier: this package was built for tier ${data.tier} (got ${tier}); rebuild with --tier ${tier}`);
   const surface = await loadSurface(options.surfaceUrl ?? new URL('../assets/surface.glb', import.meta.url).href);
   const geometry = surfaceGeometry(surface);
   const layout = layoutOf(data);
   const programs = programStorage(data);
+  const records = vertexRecords(geometry);
+  const vertices = layout.vertices;
+  // A page's deform storage is one binding: it must fit the device's maxStorageBufferBindingSize.
+  const deformBytesPerBody = vertices * DEFORM_STRIDE * 16;
+  const bindingLimit = renderer.backend.device.limits.maxStorageBufferBindingSize;
+  const fitting = Math.floor(bindingLimit / deformBytesPerBody);
+  if (fitting < 1) {
+    throw new Error(`${data.slug}: one body's deform storage (${deformBytesPerBody} bytes) exceeds this device's `
+      + `maxStorageBufferBindingSize (${bindingLimit}); build a lighter tier`);
+  }
+  const pageSize = Math.min(requestedPageSize, capacity, fitting);
   const floatsPerInstance = data.maxParts * data.poseRows * 4;
   const group = new THREE.Group();
   group.name = data.slug;
   const variants = new Map();
-  const stats = { uploads: 0, uploadBytes: 0, lastFrameBytes: 0, spawns: 0, ticks: 0 };
+  const stats = {
+    uploads: 0, uploadBytes: 0, lastFrameBytes: 0, spawns: 0, ticks: 0, deformDispatches: 0, lastFrameDeformedVertices: 0,
+  };
 
   const pages = [];
   for (let first = 0; first < capacity; first += pageSize) {
@@ -87,8 +108,9 @@ export async function createCreaturePopulation(renderer, options = {}) {
     mesh.boundingSphere = new THREE.Sphere(new THREE.Vector3(), 0);
     mesh.name = `${data.slug}.page${pages.length}`;
     group.add(mesh);
+    const deform = deformStorage(size, vertices);
     pages.push({
-      first, size, pose, mesh, staging: pose.value.array,
+      first, size, pose, mesh, staging: pose.value.array, deform, deformView: deformView(deform), kernels: new Map(), shell: null,
       alive: new Uint8Array(size), seed: new Uint32Array(size), tickOffset: new Int32Array(size),
       yaw: new Float64Array(size), position: new Float64Array(3 * size), bounds: new Float64Array(6 * size),
       dirtyLo: Infinity, dirtyHi: -1,
@@ -104,12 +126,36 @@ export async function createCreaturePopulation(renderer, options = {}) {
   const variantKey = (m) => [data.signatures.compilerSignature, data.signatures.topologySignature, data.tier, m, data.registers].join('|');
   function materialFor(page, m) {
     if (!DEBUG_MODES.includes(m)) throw new Error(`debugMode: one of ${DEBUG_MODES.join(', ')} (got ${m})`);
-    if (m === 'shell') throw new Error('debugMode shell: the diagnostic capsule shell is not part of this package yet');
-    const key = `${variantKey(m)}|page${pages.indexOf(page)}`;
-    if (!variants.has(key)) variants.set(key, createBodyMaterial(layout, page.pose, programs, m));
+    const key = `${variantKey(m === 'shell' ? 'off' : m)}|page${pages.indexOf(page)}`;
+    if (!variants.has(key)) variants.set(key, createBodyMaterial(layout, page.pose, page.deformView, m === 'shell' ? 'off' : m));
     return variants.get(key);
   }
-  for (const page of pages) page.mesh.material = materialFor(page, mode);
+  // The pre-pass variant of a mode: 'skin-only' stores uncorrected positions, every other mode the body.
+  const kernelKind = (m) => (m === 'skin-only' ? 'skin-only' : 'body');
+  function kernelFor(page, kind) {
+    if (!page.kernels.has(kind)) {
+      const fns = bodyFunctions(layout, page.pose, programs);
+      page.kernels.set(kind, createDeformKernel(layout, fns, {
+        pose: page.pose, records, deform: page.deform, size: page.size, vertices, skinOnly: kind === 'skin-only',
+      }));
+    }
+    return page.kernels.get(kind);
+  }
+  function showMode(page, m) {
+    page.mesh.material = materialFor(page, m);
+    page.kernel = kernelFor(page, kernelKind(m));
+    if (m === 'shell' && !page.shell) {
+      page.shell = createShellMesh(layout, page.pose, page.mesh.name);
+      page.shell.boundingSphere = page.mesh.boundingSphere;
+      group.add(page.shell);
+    }
+    page.mesh.visible = m !== 'shell';
+    if (page.shell) {
+      page.shell.visible = m === 'shell';
+      page.shell.count = page.mesh.count * data.slotCount;
+    }
+  }
+  for (const page of pages) showMode(page, mode);
 
   function writeInstance(page, j) {
     const base = j * floatsPerInstance;
@@ -148,13 +194,24 @@ export async function createCreaturePopulation(renderer, options = {}) {
       box.expandByPoint(corner.set(b[6 * j + 3], b[6 * j + 4], b[6 * j + 5]));
     }
     page.mesh.count = last + 1;
+    if (page.shell) page.shell.count = page.mesh.count * data.slotCount;
     if (last < 0) page.mesh.boundingSphere.set(page.mesh.boundingSphere.center.set(0, 0, 0), 0);
     else box.getBoundingSphere(page.mesh.boundingSphere);
   }
 
-  // One coalesced range per page: [first dirty instance, last dirty instance], uploaded once per flush.
+  // The pre-pass over instances lo..hi of a page, clipped to the drawn range (dead ones are skipped).
+  function deformRange(page, lo, hi) {
+    const top = Math.min(hi, page.mesh.count - 1);
+    if (top < lo) return 0;
+    stats.deformDispatches += 1;
+    return dispatchDeform(renderer, page.kernel, lo, top);
+  }
+
+  // One coalesced range per page: [first dirty instance, last dirty instance], uploaded once per flush,
+  // then that range deformed once (the upload rides on the dispatch's binding update).
   function flush() {
     let bytes = 0;
+    let deformed = 0;
     for (const page of pages) {
       if (page.dirtyHi < 0) continue;
       const start = page.dirtyLo * floatsPerInstance;
@@ -162,10 +219,12 @@ export async function createCreaturePopulation(renderer, options = {}) {
       page.pose.value.addUpdateRange(start, count);
       page.pose.value.needsUpdate = true;
       bytes += 4 * count;
+      refreshBounds(page);
+      deformed += deformRange(page, page.dirtyLo, page.dirtyHi);
       page.dirtyLo = Infinity;
       page.dirtyHi = -1;
-      refreshBounds(page);
     }
+    stats.lastFrameDeformedVertices = deformed;
     stats.lastFrameBytes = bytes;
     stats.uploadBytes += bytes;
     if (bytes) stats.uploads += 1;
@@ -193,6 +252,10 @@ export async function createCreaturePopulation(renderer, options = {}) {
     get tick() { return tick; },
     get debugMode() { return mode; },
     get capacity() { return capacity; },
+    /** Bodies per page (one draw each): the requested size, clamped to what one storage binding holds. */
+    get pageSize() { return pageSize; },
+    /** GPU bytes of deform storage per body (DEFORM_STRIDE vec4 per vertex). */
+    deformBytesPerBody,
     get count() { return pages.reduce((n, p) => n + p.alive.reduce((a, b) => a + b, 0), 0); },
     stats,
     /** Validate and write one body: O(slots), no geometry, material or pipeline is created. */
@@ -255,28 +318,42 @@ export async function createCreaturePopulation(renderer, options = {}) {
     stateHash() {
       return hashBytes(pages.map((p) => new Uint8Array(p.staging.buffer, p.staging.byteOffset, p.staging.byteLength)), tick);
     },
+    /** Switch every page to debug mode `m` (a variant built on first use; 'off' is the shipped one). */
     setDebugMode(m) {
-      for (const page of pages) page.mesh.material = materialFor(page, m);
+      if (!DEBUG_MODES.includes(m)) throw new Error(`debugMode: one of ${DEBUG_MODES.join(', ')} (got ${m})`);
+      const rerun = kernelKind(m) !== kernelKind(mode);
+      for (const page of pages) {
+        showMode(page, m);
+        if (rerun) deformRange(page, 0, page.size - 1);
+      }
       mode = m;
     },
     setTier(t) {
       if (t !== data.tier) throw new Error(`tier: this package was built for tier ${data.tier} (got ${t}); rebuild with --tier ${t}`);
     },
     variantKeys() { return [...variants.keys()]; },
-    /** Build every shipped variant's pipelines (display and shadow) before the first visible frame. */
+    /** The rest-vertex records (deform.js) every page's pre-pass reads. */
+    records,
+    /**
+     * Build every shipped variant's pipelines (deform compute, display and shadow) and every page's deform
+     * storage before the first visible frame.
+     */
     async warm(scene, camera) {
       const saved = pages.map((p) => p.mesh.count);
       for (const page of pages) page.mesh.count = Math.max(1, page.mesh.count);
       for (const m of SHIPPED_VARIANTS) {
-        for (const page of pages) page.mesh.material = materialFor(page, m);
+        for (const page of pages) {
+          showMode(page, m);
+          dispatchDeform(renderer, page.kernel, 0, 0);
+        }
         await renderer.compileAsync(scene, camera);
       }
-      for (const page of pages) page.mesh.material = materialFor(page, mode);
-      pages.forEach((p, i) => { p.mesh.count = saved[i]; });
+      pages.forEach((p, i) => { p.mesh.count = saved[i]; showMode(p, mode); });
     },
     dispose() {
       geometry.dispose();
       for (const material of variants.values()) material.dispose();
+      for (const page of pages) if (page.shell) { page.shell.geometry.dispose(); page.shell.material.dispose(); }
       group.removeFromParent();
     },
   };

@@ -7,7 +7,8 @@ export type TierName = 'hero' | 'repeated' | 'distant';
 export interface PopulationOptions {
   /** Bodies the population can hold; every page is allocated up front (default 64). */
   capacity?: number;
-  /** Bodies per page: one material and one draw call each (default 64). */
+  /** Bodies per page: one material and one draw call each (default 64; clamped so that a page's deform
+   *  storage fits the device's maxStorageBufferBindingSize). */
   pageSize?: number;
   /** Must be the tier the package was built for. */
   tier?: TierName;
@@ -36,10 +37,19 @@ export interface CreaturePopulation {
   readonly object3d: Group;
   readonly tick: number;
   readonly capacity: number;
+  /** Bodies per page: the requested pageSize clamped to what one storage binding of the device holds. */
+  readonly pageSize: number;
+  /** GPU bytes of deform storage per body (three vec4 per mesh vertex). */
+  readonly deformBytesPerBody: number;
   readonly count: number;
   readonly debugMode: DebugMode;
-  readonly stats: { uploads: number; uploadBytes: number; lastFrameBytes: number; spawns: number; ticks: number };
-  readonly pages: { mesh: Mesh }[];
+  readonly stats: {
+    uploads: number; uploadBytes: number; lastFrameBytes: number; spawns: number; ticks: number;
+    /** Deform pre-pass dispatches so far, and the vertices the last flush deformed. */
+    deformDispatches: number; lastFrameDeformedVertices: number;
+  };
+  /** One pose page: its body mesh (one draw per pass) and, once debug mode 'shell' was shown, its shell. */
+  readonly pages: { mesh: Mesh; shell: Mesh | null }[];
   /** Validation plus an O(slots) write; returns the instance id. Throws when full. */
   spawn(options?: SpawnOptions): number;
   despawn(id: number): void;
@@ -47,7 +57,7 @@ export interface CreaturePopulation {
   stepTicks(n?: number): number;
   /** Jump to tick n; returns the bytes uploaded. */
   seekTick(n: number): number;
-  /** Upload the dirty pose ranges left by spawn/despawn. */
+  /** Upload the dirty pose ranges left by spawn/despawn and run the deform pre-pass over them. */
   flush(): number;
   instance(id: number): InstanceInfo;
   stagedPose(id: number): Float32Array;
@@ -55,7 +65,7 @@ export interface CreaturePopulation {
   setDebugMode(mode: DebugMode): void;
   setTier(tier: TierName): void;
   variantKeys(): string[];
-  /** compileAsync every shipped variant (display and shadow) before the first visible frame. */
+  /** Build every shipped variant (deform compute, display, shadow) before the first visible frame. */
   warm(scene: Object3D, camera: Camera): Promise<void>;
   dispose(): void;
 }
@@ -64,6 +74,8 @@ export interface CreatureDiagnostics {
   readSkinned(id: number): Promise<{ skinned: Float32Array; corrected: Float32Array; accepted: Float32Array; gradient: Float32Array; distance: Float32Array }>;
   probeField(id: number, xyz: Float32Array, program?: number): Promise<Float32Array>;
   readPose(id: number): Promise<Float32Array>;
+  /** What the passes draw: the page's deform storage for instance `id` (creature-local). */
+  readDeformed(id: number): Promise<{ position: Float32Array; gradient: Float32Array; distance: Float32Array; accepted: Float32Array; colour: Float32Array; program: Float32Array }>;
 }
 
 export const CREATURE: Readonly<Record<string, unknown>>;

@@ -1,0 +1,63 @@
+"""The package README's picture: the built package rendered by the creature lab (headless Chromium,
+WebGPU on SwiftShader) and read back from a render target, before the package folder is committed.
+
+It is part of the build, so a build with the picture needs the lab (Chromium and web_lab/node_modules).
+``picture_unavailable`` says why it cannot run here, so ``--picture auto`` can build without it and say so.
+"""
+
+from __future__ import annotations
+
+import base64
+from pathlib import Path
+
+import numpy as np
+
+from ..lab.png import encode_png
+
+#: The README picture's path inside the package, and its size (pixels).
+PICTURE_PATH = "assets/preview.png"
+PICTURE_SIZE = (480, 320)
+#: The tick and seed it shows (the parity job's pose, so the picture is the body the gates measured).
+PICTURE_TICK = 37
+PICTURE_SEED = 1
+
+
+def picture_unavailable() -> str | None:
+    """None when the lab can render here, else the reason it cannot."""
+    from ..lab.browser import find_chromium
+    from ..lab.server import WEB_LAB
+
+    if not (WEB_LAB / "node_modules" / "three" / "package.json").is_file():
+        return f"{WEB_LAB}/node_modules has no three (run `make setup` or `npm ci` in web_lab/)"
+    try:
+        find_chromium()
+    except RuntimeError as exc:
+        return str(exc)
+    return None
+
+
+def render_picture(package: Path) -> bytes:
+    """PNG bytes of body 0 of ``package`` (a package folder, possibly not yet committed) in the lab."""
+    from ..lab.browser import launch_lab_page
+    from ..lab.server import WEB_LAB, serve
+
+    width, height = PICTURE_SIZE
+    url_path = (
+        f"creature.html?pkg={package.name}&w={width}&h={height}&seed={PICTURE_SEED}&capacity=1&pageSize=1"
+    )
+    with (
+        serve(WEB_LAB, mounts={"out": package.parent}) as base,
+        launch_lab_page(base + url_path, timeout_s=300) as lab_page,
+    ):
+        error = lab_page.lab.get("error")
+        if error:
+            raise RuntimeError(f"the lab could not load the package: {error}")
+        page = lab_page.page
+        page.evaluate(f"() => window.__lab.seekTick({PICTURE_TICK})")
+        shot = page.evaluate("() => window.__lab.capturePixels('portrait')")
+        page.evaluate("() => window.__lab.finish()")
+        errors: list[str] = page.evaluate("() => window.__lab.errors")
+        if errors:
+            raise RuntimeError(f"GPU errors while rendering the picture: {errors[:3]}")
+    raw = np.frombuffer(base64.b64decode(shot["rgba"]), dtype=np.uint8)
+    return encode_png(raw.reshape(int(shot["height"]), int(shot["width"]), 4))

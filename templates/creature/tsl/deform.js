@@ -1,0 +1,88 @@
+// The deform pre-pass of a pose page: a compute kernel runs every vertex of every live body in a dirty
+// range through the body path once (skin, bounded correction, one field evaluation at the final
+// position) and stores what the passes draw. The display pass and the shadow pass then read the same
+// stored position, so the shadow is cast by the very surface that is seen, and no vertex is skinned or
+// evaluated twice in a frame (a vertex stage would re-run the whole path per pass, and per re-shaded
+// vertex on a rasteriser without a post-transform cache, such as SwiftShader).
+import { Fn, If, float, instanceIndex, instancedArray, int, storage, uniform, vec4 } from 'three/tsl';
+import { bodyVertex } from './body.js';
+
+/** vec4 per drawn vertex: (position, distance), (gradient, accepted), (albedo, program). */
+export const DEFORM_STRIDE = 3;
+/** vec4 per rest vertex: (rest, 0), slots, weights, (centre of rotation, 0), (method, trust, program, 0). */
+export const RECORD_STRIDE = 5;
+
+/** The rest-vertex records (one read-only storage node shared by every page and kernel). */
+export function vertexRecords(geometry) {
+  const a = geometry.attributes;
+  const n = a.position.count;
+  const out = new Float32Array(4 * RECORD_STRIDE * n);
+  for (let v = 0; v < n; v++) {
+    const o = 4 * RECORD_STRIDE * v;
+    for (let c = 0; c < 3; c++) {
+      out[o + c] = a.position.array[3 * v + c];
+      out[o + 12 + c] = a.cgCor.array[3 * v + c];
+    }
+    for (let c = 0; c < 4; c++) {
+      out[o + 4 + c] = a.cgSlots.array[4 * v + c];
+      out[o + 8 + c] = a.cgWeights.array[4 * v + c];
+      out[o + 16 + c] = a.cgSkin.array[4 * v + c];
+    }
+  }
+  return instancedArray(out, 'vec4').toReadOnly();
+}
+
+/** The record of rest vertex `v` as the inputs bodyVertex takes. */
+export function recordInputs(records, v) {
+  const r = v.mul(RECORD_STRIDE);
+  return {
+    rest: records.element(r).xyz, slots: records.element(r.add(1)), weights: records.element(r.add(2)),
+    cor: records.element(r.add(3)).xyz, skin: records.element(r.add(4)),
+  };
+}
+
+/** The deformed-vertex storage of a page of `size` bodies (written by compute, read by the passes). */
+export function deformStorage(size, vertices) {
+  return instancedArray(size * vertices * DEFORM_STRIDE, 'vec4');
+}
+
+/** A read-only view of a page's deformed vertices for the vertex stage (same GPU buffer). */
+export function deformView(deform) {
+  return storage(deform.value, 'vec4', deform.value.count).toReadOnly();
+}
+
+/**
+ * The deform kernel of one page over `fns` (bodyFunctions, or a lab baseline's). Dispatch it with
+ * dispatchDeform, which limits it to a range of instances; dead instances are skipped (the vertex stage
+ * draws them collapsed to the origin).
+ */
+export function createDeformKernel(layout, fns, { pose, records, deform, size, vertices, skinOnly = false }) {
+  const first = uniform(0, 'int');
+  const rowsPerInstance = layout.maxParts * layout.rows;
+  const kernel = Fn(() => {
+    const idx = int(instanceIndex).add(first.mul(vertices)).toVar();
+    const j = idx.div(vertices).toVar();
+    const v = idx.sub(j.mul(vertices)).toVar();
+    const base = j.mul(rowsPerInstance).toVar();
+    const alive = pose.element(base.add(layout.slotCount * layout.rows)).w;
+    If(alive.greaterThan(0.5), () => {
+      const body = bodyVertex(layout, fns, { ...recordInputs(records, v), base, skinOnly, colour: true });
+      const o = idx.mul(DEFORM_STRIDE).toVar();
+      deform.element(o).assign(vec4(body.position, body.distance));
+      deform.element(o.add(1)).assign(vec4(body.gradient, body.accepted));
+      deform.element(o.add(2)).assign(vec4(body.colour, float(body.program)));
+    });
+  })().compute(size * vertices);
+  kernel.setName(skinOnly ? 'cgDeformSkinOnly' : 'cgDeform');
+  return { kernel, first, vertices, size };
+}
+
+/** Run `deform` over instances lo..hi of its page (inclusive); returns the vertices processed. */
+export function dispatchDeform(renderer, deform, lo, hi) {
+  const count = (hi - lo + 1) * deform.vertices;
+  if (count <= 0) return 0;
+  deform.first.value = lo;
+  deform.kernel.count = count;
+  renderer.compute(deform.kernel);
+  return count;
+}
