@@ -38,21 +38,9 @@ def picture_unavailable() -> str | None:
 
 def render_picture(package: Path) -> bytes:
     """PNG bytes of body 0 of ``package`` (a package folder, possibly not yet committed) in the lab."""
-    from ..lab.browser import launch_lab_page
-    from ..lab.server import WEB_LAB, serve
+    from ..lab.creature_parity import open_creature_lab
 
-    width, height = PICTURE_SIZE
-    url_path = (
-        f"creature.html?pkg={package.name}&w={width}&h={height}&seed={PICTURE_SEED}&capacity=1&pageSize=1"
-    )
-    with (
-        serve(WEB_LAB, mounts={"out": package.parent}) as base,
-        launch_lab_page(base + url_path, timeout_s=300) as lab_page,
-    ):
-        error = lab_page.lab.get("error")
-        if error:
-            raise RuntimeError(f"the lab could not load the package: {error}")
-        page = lab_page.page
+    with open_creature_lab(package, PICTURE_SIZE, seed=PICTURE_SEED, capacity=1, pageSize=1) as page:
         page.evaluate(f"() => window.__lab.seekTick({PICTURE_TICK})")
         shot = page.evaluate("() => window.__lab.capturePixels('portrait')")
         page.evaluate("() => window.__lab.finish()")

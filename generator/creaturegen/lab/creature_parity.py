@@ -67,8 +67,13 @@ def _rgba(shot: dict[str, Any]) -> npt.NDArray[np.uint8]:
 
 
 @contextlib.contextmanager
-def open_creature_lab(package: Path, canvas: tuple[int, int] = DEFAULT_CANVAS) -> Iterator[Page]:
-    url_path = f"creature.html?pkg={package.name}&w={canvas[0]}&h={canvas[1]}&seed={LAB_SEED}"
+def open_creature_lab(
+    package: Path, canvas: tuple[int, int] = DEFAULT_CANVAS, **query: int
+) -> Iterator[Page]:
+    """The creature lab page on ``package`` (any folder: its parent is served as /out/); ``query`` adds
+    page parameters (capacity, pageSize, seed)."""
+    params = {"pkg": package.name, "w": canvas[0], "h": canvas[1], "seed": LAB_SEED, **query}
+    url_path = "creature.html?" + "&".join(f"{k}={v}" for k, v in params.items())
     with (
         serve(WEB_LAB, mounts={"out": package.parent}) as base,
         launch_lab_page(base + url_path, timeout_s=300) as lab_page,
