@@ -64,6 +64,26 @@ def no_build_pictures() -> Iterator[None]:
         os.environ["CREATUREGEN_PICTURE"] = previous
 
 
+@pytest.fixture(scope="session")
+def creature_out(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """One output folder for example packages, shared by every test that needs a built creature."""
+    return tmp_path_factory.mktemp("creature-out")
+
+
+def build_example(name: str, out_root: Path) -> Path:
+    """examples/<name> built through the command line into ``out_root`` (once per session)."""
+    import json
+
+    from creaturegen.spec import slugify
+
+    spec = EXAMPLES / name
+    package = out_root / slugify(json.loads(spec.read_text())["name"])
+    if not package.exists():
+        result = run_cli("build", str(spec), "-o", str(out_root))
+        assert result.returncode == 0, result.stdout[-2000:] + result.stderr[-4000:]
+    return package
+
+
 def run_cli(*args: str, cwd: Path = REPO) -> subprocess.CompletedProcess[str]:
     """The installed command line in a child process, as a user runs it."""
     return subprocess.run(

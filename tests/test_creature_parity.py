@@ -18,23 +18,17 @@ from pathlib import Path
 
 import pytest
 
-from conftest import CREATURE_EXAMPLES, EXAMPLES, run_cli
+from conftest import CREATURE_EXAMPLES, build_example
 from creaturegen.lab.creature_parity import GATE_GROUPS, run_creature_parity
-from creaturegen.spec import slugify
 
 
-@pytest.fixture(scope="module")
-def out_root(tmp_path_factory: pytest.TempPathFactory) -> Path:
-    return tmp_path_factory.mktemp("creature-out")
+@pytest.fixture
+def out_root(creature_out: Path) -> Path:
+    return creature_out
 
 
 def build(name: str, out_root: Path) -> Path:
-    spec = EXAMPLES / name
-    package = out_root / slugify(json.loads(spec.read_text())["name"])
-    if not package.exists():
-        result = run_cli("build", str(spec), "-o", str(out_root))
-        assert result.returncode == 0, result.stdout[-2000:] + result.stderr[-4000:]
-    return package
+    return build_example(name, out_root)
 
 
 @pytest.mark.browser

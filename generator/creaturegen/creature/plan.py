@@ -16,6 +16,7 @@ from .. import __version__
 from ..candidates import TierRejectedError, build_candidates
 from ..field.floors import floors_for
 from ..field.primitives import GRADIENT_FLOOR, slot_uses_round_cone
+from ..motion.rig import build_motion
 from ..rig import CompiledRig
 from ..spec import CharacterSpec, slugify
 from ..surface import correct as correction
@@ -69,6 +70,7 @@ def build_plan(
 ) -> CreaturePlan:
     skeleton = build_skeleton(spec, rig)
     sway = sway_module.build_sway(rig, skeleton)
+    motion = build_motion(spec, rig, skeleton)
     tapes, note = program_tapes(spec, rig, surface.tier)
     floors = floors_for(rig.body_scale)
     asset = surface.asset
@@ -98,7 +100,8 @@ def build_plan(
             "period": sway.period,
         },
         "lcg": {"a": sway_module.LCG_A, "c": sway_module.LCG_C},
-        "tickRate": 60,
+        "motion": motion,
+        "tickRate": motion["hz"],
         "programData": program_data(tapes),
         "programCount": len(tapes),
         "fullProgram": len(tapes) - 1,

@@ -86,7 +86,7 @@ def _locomotion_schema_conditionals(schema: dict[str, Any]) -> None:
     schema["allOf"] = [
         {
             "if": {"properties": {"type": {"const": kind}}, "required": ["type"]},
-            "then": {"required": list(fields), "propertyNames": {"enum": ["type", *fields]}},
+            "then": {"required": list(fields), "propertyNames": {"enum": ["type", "tickRate", *fields]}},
         }
         for kind, fields in LOCOMOTION_FIELDS.items()
     ]
@@ -98,6 +98,9 @@ class Locomotion(StrictModel):
     model_config = ConfigDict(json_schema_extra=_locomotion_schema_conditionals)
 
     type: LocomotionType = Field(description="Locomotion driver.")
+    tickRate: Literal[60, 120] | None = Field(
+        default=None, description="Fixed steps per second of the locomotion driver; default 60."
+    )
     speed: NonNegative | None = Field(default=None, description="Ground or air speed, m/s.")
     stepLength: Positive | None = Field(default=None, description="Foot lag that triggers a step, m.")
     stepHeight: Positive | None = Field(default=None, description="Swing arc apex above support, m.")

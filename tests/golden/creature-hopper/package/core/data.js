@@ -30,6 +30,144 @@ export const CREATURE = Object.freeze({
     "triangles": 12912,
     "vertices": 6458
   },
+  "motion": {
+    "altitude": 0.0,
+    "bodyScale": 1.24,
+    "buoyancy": 1.0,
+    "centreY": 0.5599999999999999,
+    "constants": {
+      "hopCrouchS": 0.12,
+      "hopLandS": 0.12,
+      "hopSquash": 0.18,
+      "hopStretch": 0.12,
+      "ropeDamping": 0.02,
+      "ropePasses": 4,
+      "ropeSubsteps": 2,
+      "stepLead": 0.5,
+      "strouhal": 0.3,
+      "swimResponse": 1.0,
+      "swingFroude": 1.0
+    },
+    "groundY": -0.06,
+    "groups": 0,
+    "hopHeight": 1.05,
+    "hopLength": 1.4,
+    "hz": 60,
+    "legs": [],
+    "order": [
+      0,
+      1,
+      2,
+      3,
+      4,
+      5,
+      6
+    ],
+    "parent": [
+      -1,
+      0,
+      0,
+      2,
+      3,
+      4,
+      5
+    ],
+    "pathRadius": 7.4399999999999995,
+    "pivot": [
+      [
+        0.0,
+        0.18,
+        0.0
+      ],
+      [
+        0.0,
+        0.3,
+        0.0
+      ],
+      [
+        0.0,
+        0.38,
+        -0.18
+      ],
+      [
+        0.0,
+        0.38,
+        -0.304
+      ],
+      [
+        0.0,
+        0.38,
+        -0.428
+      ],
+      [
+        0.0,
+        0.38,
+        -0.552
+      ],
+      [
+        0.0,
+        0.38,
+        -0.6759999999999999
+      ]
+    ],
+    "roots": [
+      0
+    ],
+    "ropes": [
+      {
+        "parent": 0,
+        "part": "counter-tail",
+        "rest": [
+          [
+            0.0,
+            0.38,
+            -0.18
+          ],
+          [
+            0.0,
+            0.38,
+            -0.304
+          ],
+          [
+            0.0,
+            0.38,
+            -0.428
+          ],
+          [
+            0.0,
+            0.38,
+            -0.552
+          ],
+          [
+            0.0,
+            0.38,
+            -0.6759999999999999
+          ],
+          [
+            0.0,
+            0.38,
+            -0.8
+          ]
+        ],
+        "segment": 0.124,
+        "slots": [
+          2,
+          3,
+          4,
+          5,
+          6
+        ]
+      }
+    ],
+    "speed": 1.0,
+    "stepHeight": 0.0,
+    "stepLength": 0.0,
+    "stepLengthSpec": 0.0,
+    "stepLimit": 0.0,
+    "type": "hopper",
+    "undulation": 0.0,
+    "wings": []
+  },
   "name": "Hopper Squash Core",
   "noProgram": 65535,
   "poseRows": 5,

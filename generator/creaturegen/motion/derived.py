@@ -1,0 +1,113 @@
+"""Numbers derived at spawn time from the motion data and the injected gravity: swing and hop durations
+quantised to whole ticks, flap and undulation frequencies, the swimmer's response rate.
+
+Rounding rule (stated once, used everywhere seconds become ticks): ``ticks(s) = floor(s·hz + 0.5)``,
+round half up, identical in Python and JS (Python's ``round`` is half-even, so it is not used).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Any
+
+
+def ticks_from_seconds(seconds: float, hz: int) -> int:
+    return math.floor(seconds * hz + 0.5)
+
+
+@dataclass(frozen=True)
+class Derived:
+    hz: int
+    dt: float
+    g: float
+    swing: int  # swing duration, ticks
+    window: int  # lift window per phase group, ticks
+    cycle: int  # gait cycle, ticks
+    half_air: int
+    air: int
+    crouch: int
+    land: int
+    hop_cycle: int
+    hop_idle: int
+    v0: float
+    apex: float
+    flap_hz: float
+    bank: float  # reported; the pose uses its half-angle sine and cosine (square roots only)
+    bank_half_sin: float
+    bank_half_cos: float
+    swim_omega: float
+    swim_depth: float
+    undulation_hz: float
+
+    def as_dict(self) -> dict[str, Any]:
+        return dict(self.__dict__)
+
+
+def derive(data: dict[str, Any], gravity: list[float]) -> Derived:
+    hz = int(data["hz"])
+    dt = 1.0 / hz
+    g = math.sqrt(gravity[0] * gravity[0] + gravity[1] * gravity[1] + gravity[2] * gravity[2])
+    c = data["constants"]
+    speed = data["speed"]
+    body = data["bodyScale"]
+    legs = data["legs"]
+    swing = window = cycle = 0
+    if legs:
+        leg_len = sum(leg["a"] + leg["b"] for leg in legs) / len(legs)
+        swing = max(2, ticks_from_seconds(c["swingFroude"] * math.sqrt(leg_len / g), hz))
+        groups = data["groups"]
+        # A foot lands stepLead·s ahead of home and lifts once it lags s behind: planted for
+        # (1 + stepLead)·s / v seconds. The cycle is that stance plus the swing, a whole number of
+        # windows, so a steady gait lifts each group right as its window opens.
+        stance = 0
+        if speed > 0.0:
+            stance = math.floor((1.0 + c["stepLead"]) * data["stepLength"] / (speed * dt)) + 1
+        window = max(swing + 1, -(-(swing + stance) // groups))
+        cycle = groups * window
+    half_air = max(1, ticks_from_seconds(math.sqrt(2.0 * data["hopHeight"] / g), hz))
+    air = 2 * half_air
+    crouch = max(2, ticks_from_seconds(c["hopCrouchS"], hz))
+    land = max(2, ticks_from_seconds(c["hopLandS"], hz))
+    busy = crouch + air + land
+    hop_cycle = busy + 1
+    if speed > 0.0 and data["hopLength"] > 0.0:
+        hop_cycle = max(busy + 1, ticks_from_seconds(data["hopLength"] / speed, hz))
+    t_half = half_air * dt
+    v0 = g * t_half
+    flap_hz = 0.0
+    wings = data["wings"]
+    if wings:
+        excursion = max(2.0 * w["amplitude"] * w["length"] for w in wings)
+        flap_hz = c["strouhal"] * speed / excursion if excursion > 0.0 else 0.0
+    radius = data["pathRadius"]
+    bank = math.atan2(speed * speed, g * radius) if radius > 0.0 else 0.0
+    # Coordinated turn: tan β = v²/(g R); cos β from a square root, then the half angle, so no library
+    # trigonometry reaches the pose.
+    lift = g * radius
+    cos_bank = lift / math.sqrt(speed * speed * (speed * speed) + lift * lift) if radius > 0.0 else 1.0
+    undulation = data["undulation"]
+    undulation_hz = c["strouhal"] * speed / (2.0 * undulation * body) if undulation > 0.0 else 0.0
+    return Derived(
+        hz=hz,
+        dt=dt,
+        g=g,
+        swing=swing,
+        window=window,
+        cycle=cycle,
+        half_air=half_air,
+        air=air,
+        crouch=crouch,
+        land=land,
+        hop_cycle=hop_cycle,
+        hop_idle=hop_cycle - busy,
+        v0=v0,
+        apex=0.5 * g * t_half * t_half,
+        flap_hz=flap_hz,
+        bank=bank,
+        bank_half_sin=math.sqrt((1.0 - cos_bank) * 0.5),
+        bank_half_cos=math.sqrt((1.0 + cos_bank) * 0.5),
+        swim_omega=c["swimResponse"] * math.sqrt(g / body),
+        swim_depth=(1.0 - data["buoyancy"]) * body,
+        undulation_hz=undulation_hz,
+    )

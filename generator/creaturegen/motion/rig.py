@@ -1,0 +1,185 @@
+"""Build-time motion data: which slots are legs, ropes and wings, rest frames, and the stated constants.
+
+Everything here is plain numbers derived from the compiled rig and skeleton; ``runtime_data`` is what the
+package's core/data.js carries as ``CREATURE.motion``, and the Python reference reads the same object, so
+the two cannot drift apart. Quantities that depend on gravity (swing time, hop air time) are derived at
+runtime from the injected gravity provider, not here.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any, Final
+
+from ..field import layout as col
+from ..rig import CompiledRig
+from ..spec import CharacterSpec
+from ..surface.skeleton import Skeleton
+
+#: Walkers, hoppers and swimmers circle at this many body lengths (flyers use their spec radius).
+PATH_RADIUS_BODIES: Final = 6.0
+#: Swing time ``SWING_FROUDE·sqrt(leg/g)`` (dynamic similarity: equal Froude number across leg lengths).
+SWING_FROUDE: Final = 1.0
+#: A foot lands this fraction of stepLength ahead of its home; it lifts when it lags stepLength behind.
+STEP_LEAD: Final = 0.5
+#: The lag that triggers a step is capped at this fraction of the shortest leg's horizontal reach at
+#: rest hip height, so a stance never asks the IK for more than the leg has (the spec's stepLength is
+#: kept and reported beside the cap).
+REACH_STEP_FRACTION: Final = 0.6
+#: IK reach clamp as a fraction of leg length (a + b): dist ∈ [|a−b| + m(a+b), (a+b)(1−m)].
+REACH_MARGIN: Final = 1e-3
+#: Hopper: crouch and landing durations (s), squash depth and air stretch (dimensionless).
+HOP_CROUCH_S: Final = 0.12
+HOP_LAND_S: Final = 0.12
+HOP_SQUASH: Final = 0.18
+HOP_STRETCH: Final = 0.12
+#: Flap and undulation frequency from a Strouhal number ``f·A/U`` (A = tip excursion).
+STROUHAL: Final = 0.3
+#: Swimmer: critically damped response at ``SWIM_RESPONSE·√(g/L)`` rad/s.
+SWIM_RESPONSE: Final = 1.0
+#: Verlet ropes: substeps per tick, relaxation passes per substep, velocity damping per substep.
+ROPE_SUBSTEPS: Final = 2
+ROPE_PASSES: Final = 4
+ROPE_DAMPING: Final = 0.02
+TICK_RATES: Final = (60, 120)
+
+WALKERS: Final = ("biped", "quadruped", "hexapod")
+
+
+def _v(x: Any) -> list[float]:
+    return [float(c) for c in x]
+
+
+def fields_of(loco: Any) -> dict[str, Any]:
+    return loco.model_dump(exclude_none=True) if loco is not None else {}
+
+
+def build_motion(spec: CharacterSpec, rig: CompiledRig, skeleton: Skeleton) -> dict[str, Any]:
+    """``CREATURE.motion``: plain JSON numbers, read by the Python reference and the JS core alike."""
+    loco = spec.locomotion
+    kind = loco.type if loco is not None else "none"
+    slots = rig.slots
+    by_part: dict[str, list[int]] = {}
+    for index, owner in enumerate(rig.slot_parts):
+        by_part.setdefault(owner, []).append(index)
+    body = float(rig.body_scale)
+
+    phases = sorted({float(p.phase or 0.0) for p in spec.parts if p.shape == "leg"})
+    legs: list[dict[str, Any]] = []
+    for part in spec.parts:
+        if part.shape != "leg":
+            continue
+        upper, lower = by_part[part.id]
+        assert rig.slot_classes[upper] == "leg-upper"
+        assert rig.slot_classes[lower] == "leg-lower"
+        hip, knee, foot = _v(slots[upper, col.A]), _v(slots[upper, col.B]), _v(slots[lower, col.B])
+        mid = [(hip[i] + foot[i]) * 0.5 for i in range(3)]
+        hint = [knee[i] - mid[i] for i in range(3)]
+        norm = math.sqrt(sum(c * c for c in hint)) or 1.0
+        a = math.dist(hip, knee)
+        b = math.dist(knee, foot)
+        legs.append(
+            {
+                "part": part.id,
+                "upper": upper,
+                "lower": lower,
+                "hip": hip,
+                "knee": knee,
+                "foot": foot,
+                "a": a,
+                "b": b,
+                "hint": [c / norm for c in hint],
+                "group": phases.index(float(part.phase or 0.0)),
+                "reachMin": abs(a - b) + REACH_MARGIN * (a + b),
+                "reachMax": (a + b) * (1.0 - REACH_MARGIN),
+            }
+        )
+    ropes = []
+    for part in spec.parts:
+        if part.shape != "rope":
+            continue
+        chain = by_part[part.id]
+        rest = [_v(slots[s, col.A]) for s in chain] + [_v(slots[chain[-1], col.B])]
+        ropes.append(
+            {
+                "part": part.id,
+                "slots": chain,
+                "parent": skeleton.parent[chain[0]],
+                "rest": rest,
+                "segment": math.dist(rest[0], rest[1]),
+            }
+        )
+    wings = []
+    for part in spec.parts:
+        if part.flap is None:
+            continue
+        (slot,) = by_part[part.id]
+        start, end = _v(slots[slot, col.A]), _v(slots[slot, col.B])
+        wings.append(
+            {
+                "part": part.id,
+                "slot": slot,
+                "sign": 1.0 if end[0] >= start[0] else -1.0,
+                "amplitude": float(part.flap),
+                "length": math.dist(start, end),
+            }
+        )
+    step_spec = float(fields_of(loco).get("stepLength", 0.0)) * spec.scale
+    step_limit = 0.0
+    if legs:
+        ground = sum(leg["foot"][1] for leg in legs) / len(legs)
+        horizontal = [
+            math.sqrt(max(leg["reachMax"] ** 2 - (leg["hip"][1] - ground) ** 2, 0.0)) for leg in legs
+        ]
+        step_limit = REACH_STEP_FRACTION * min(horizontal)
+    else:
+        ground = float(min(min(s[1] - s[3], s[5] - s[7]) for s in slots.tolist()))
+    roots = [s for s in range(rig.slot_count) if skeleton.parent[s] < 0]
+    depth = [0] * rig.slot_count
+    for s in range(rig.slot_count):
+        walk = s
+        while skeleton.parent[walk] >= 0:
+            walk, depth[s] = skeleton.parent[walk], depth[s] + 1
+    order = sorted(range(rig.slot_count), key=lambda s: (depth[s], s))
+    centre_y = sum(0.5 * (float(slots[r, 1]) + float(slots[r, 5])) for r in roots) / len(roots)
+    fields = fields_of(loco)
+    speed = float(fields.get("speed", 0.0))
+    return {
+        "type": kind,
+        "hz": int(fields.get("tickRate", 60)),
+        "speed": speed,
+        "bodyScale": body,
+        "groundY": ground,
+        "centreY": centre_y,
+        "pathRadius": float(fields["radius"]) * spec.scale if kind == "flyer" else PATH_RADIUS_BODIES * body,
+        "stepLength": min(step_spec, step_limit) if legs else step_spec,
+        "stepLengthSpec": step_spec,
+        "stepLimit": step_limit,
+        "stepHeight": float(fields.get("stepHeight", 0.0)) * spec.scale,
+        "hopLength": float(fields.get("hopLength", 0.0)) * spec.scale,
+        "hopHeight": float(fields.get("hopHeight", 0.0)) * spec.scale,
+        "altitude": float(fields.get("altitude", 0.0)) * spec.scale,
+        "undulation": float(fields.get("undulation", 0.0)),
+        "buoyancy": float(fields.get("buoyancy", 1.0)),
+        "groups": len(phases),
+        "legs": legs,
+        "ropes": ropes,
+        "wings": wings,
+        "roots": roots,
+        "parent": list(skeleton.parent),
+        "order": order,
+        "pivot": [_v(p) for p in skeleton.pivot],
+        "constants": {
+            "swingFroude": SWING_FROUDE,
+            "stepLead": STEP_LEAD,
+            "hopCrouchS": HOP_CROUCH_S,
+            "hopLandS": HOP_LAND_S,
+            "hopSquash": HOP_SQUASH,
+            "hopStretch": HOP_STRETCH,
+            "strouhal": STROUHAL,
+            "swimResponse": SWIM_RESPONSE,
+            "ropeSubsteps": ROPE_SUBSTEPS,
+            "ropePasses": ROPE_PASSES,
+            "ropeDamping": ROPE_DAMPING,
+        },
+    }

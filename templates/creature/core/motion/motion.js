@@ -1,0 +1,549 @@
+// One creature's locomotion in float64, tick by tick: the same formulas in the same order as creaturegen's
+// Python reference (motion/simulate.py). Order of writes per tick (the last stage touching a slot wins):
+//   1. root: position, yaw and squash (closed form for walkers, hoppers and flyers; the swimmer's vertical
+//      response is integrated);
+//   2. base pose: per-slot local rotations composed down the skeleton (flyer bank and flap, swimmer
+//      undulation; identity otherwise);
+//   3. legs: plant in the support frame → world target → inverse root transform → body-frame IK →
+//      creature-local leg slots;
+//   4. ropes: fixed-step verlet in world space, the anchor following the posed body, written last.
+// Integer ticks are authoritative: seekTick(n) resets and steps n times, so it equals n step() calls bit
+// for bit. Nothing allocates after createMotion (typed scratch only); the only variation is the seeded LCG.
+
+import { instanceOffset } from '../lcg.js';
+import { hashBytes } from '../hash.js';
+import { axisAngle, fromFrames, fromTo, gramSchmidt, mul, normalizeInto, rotate } from './quat.js';
+import { SWIMMER_CHANNELS, createFlatGround, createGravity, toLocal, toWorld } from './providers.js';
+import { derive } from './derived.js';
+import { pcos, psin } from './trig.js';
+
+const WALKERS = ['biped', 'quadruped', 'hexapod'];
+const GATE_NAMES = ['plantDrift', 'ikResidual', 'drawnFoot', 'clampedTicks', 'plantedSamples', 'bothSwingTicks', 'steps',
+  'ropeAnchor', 'swimTracking', 'apexError', 'apexSquash', 'squashDet'];
+const G = Object.freeze(Object.fromEntries(GATE_NAMES.map((name, i) => [name, i])));
+
+export class TierRefusedError extends Error {}
+
+export function createMotion(data, lcg, { support = createFlatGround(), gravity = createGravity(), water = null, seed = 0, position = [0, 0, 0] } = {}) {
+  const m = data;
+  const kind = m.type;
+  if (kind === 'swimmer') {
+    if (!water) throw new TierRefusedError('swimmer: no WaterSurfaceProvider was injected');
+    const missing = SWIMMER_CHANNELS.filter((c) => !water.channels.includes(c));
+    if (missing.length) throw new TierRefusedError(`swimmer: the water provider does not represent ${missing.join(', ')}`);
+  }
+  const gravity0 = gravity.at(0, new Float64Array(3));
+  const d = derive(m, gravity0);
+  const { yaw } = instanceOffset(seed, lcg, 1);
+  const theta0 = -yaw;
+  const pos = Float64Array.from(position);
+  const S = m.parent.length;
+  const L = m.legs.length;
+  const isWalker = WALKERS.includes(kind);
+  const hasCurrent = water ? water.channels.includes('materialCurrentVelocityMps') : false;
+  const sample = water ? water.createSample() : null;
+
+  // state
+  const quats = new Float64Array(4 * S);
+  const trans = new Float64Array(3 * S);
+  const root = new Float64Array(6); // x, y, z, cos yaw, sin yaw, squash
+  const prevQuats = new Float64Array(4 * S);
+  const prevTrans = new Float64Array(3 * S);
+  const prevRoot = new Float64Array(6);
+  const centre = new Float64Array(3);
+  const planted = new Uint8Array(L);
+  const plant = new Float64Array(3 * L);
+  const swingFrom = new Float64Array(3 * L);
+  const swingTo = new Float64Array(3 * L);
+  const liftTick = new Int32Array(L);
+  const nodes = m.ropes.map((r) => new Float64Array(3 * r.rest.length));
+  const prevNodes = m.ropes.map((r) => new Float64Array(3 * r.rest.length));
+  const swim = new Float64Array(2); // y, vy
+  let tick = 0;
+  // Worst values since reset, measured every tick (motion/simulate.py Gates), in one typed array.
+  const gv = new Float64Array(GATE_NAMES.length);
+
+  // scratch
+  const frame = new Float64Array(12);
+  const frame2 = new Float64Array(12);
+  const root2 = new Float64Array(6);
+  const v3 = new Float64Array(3);
+  const w3 = new Float64Array(3);
+  const home = new Float64Array(3);
+  const ahead = new Float64Array(3);
+  const local = new Float64Array(3);
+  const target = new Float64Array(3);
+  const hopOut = new Float64Array(3);
+  const path = new Float64Array(3);
+  const locals = new Float64Array(4 * S);
+  const hasLocal = new Uint8Array(S);
+  const turned = new Float64Array(3);
+  const frames = new Float64Array(12);
+  const ik = new Float64Array(16); // knee 0..2, foot 3..5, flags 6 (clamped), 7 (residual)
+  const grav = new Float64Array(3);
+  const anchorLocal = new Float64Array(3);
+  const anchorWorld = new Float64Array(3);
+  const localNodes = new Float64Array(3 * Math.max(1, ...m.ropes.map((r) => r.rest.length)));
+  const e0 = new Float64Array(3);
+  const e1 = new Float64Array(3);
+  const q = new Float64Array(4);
+
+  function resetGates() {
+    gv.fill(0);
+    gv[G.apexSquash] = 1;
+  }
+
+  /** The gates as a plain object (allocates; the per-tick path writes the typed array only). */
+  function readGates() {
+    const out = {};
+    for (const [name, index] of Object.entries(G)) out[name] = gv[index];
+    return out;
+  }
+
+  // --- root ------------------------------------------------------------------------------------------
+
+  function pathAt(dist, out) {
+    const radius = m.pathRadius;
+    const theta = theta0 + dist / radius;
+    out[0] = centre[0] + radius * pcos(theta);
+    out[1] = centre[2] + radius * psin(theta);
+    out[2] = -theta;
+  }
+
+  function settle(f, c, s) {
+    const ny = f[7];
+    let lowest = 0;
+    for (let i = 0; i < L; i++) {
+      const ft = m.legs[i].foot;
+      const rx = c * ft[0] + s * ft[2];
+      const rz = -s * ft[0] + c * ft[2];
+      const dy = -(f[6] * rx + f[8] * rz) / ny;
+      if (dy < lowest) lowest = dy;
+    }
+    return lowest;
+  }
+
+  function grounded(f, u, w, psi, lift, squash, out) {
+    toWorld(f, u, 0, w, v3, 0);
+    const sp = psin(psi), cp = pcos(psi);
+    const fx = sp * f[3] + cp * f[9];
+    const fz = sp * f[5] + cp * f[11];
+    const norm = Math.sqrt(fx * fx + fz * fz);
+    const c = fz / norm, s = fx / norm;
+    if (L) lift = lift + settle(f, c, s);
+    out[0] = v3[0]; out[1] = v3[1] + lift - m.groundY * squash; out[2] = v3[2]; out[3] = c; out[4] = s; out[5] = squash;
+  }
+
+  function hopAt(n, out) {
+    const c = m.constants;
+    const hopLength = m.speed > 0 ? m.hopLength : 0;
+    const k = Math.floor(n / d.hopCycle);
+    let r = n % d.hopCycle;
+    if (r < d.hopIdle) { out[0] = k * hopLength; out[1] = 0; out[2] = 1; return; }
+    r -= d.hopIdle;
+    if (r < d.crouch) { out[0] = k * hopLength; out[1] = 0; out[2] = 1 - c.hopSquash * psin(Math.PI * (r / d.crouch)); return; }
+    r -= d.crouch;
+    if (r < d.air) {
+      const ts = r * d.dt;
+      const tau = r / d.air;
+      const e = 2 * tau - 1;
+      out[0] = k * hopLength + hopLength * tau;
+      out[1] = d.v0 * ts - 0.5 * d.g * ts * ts;
+      out[2] = 1 + c.hopStretch * (e * e);
+      return;
+    }
+    r -= d.air;
+    out[0] = (k + 1) * hopLength; out[1] = 0; out[2] = 1 - c.hopSquash * psin(Math.PI * (r / d.land));
+  }
+
+  /** Support frame and root (x, y, z, cos yaw, sin yaw, squash) at tick n. */
+  function rootAt(n, f, out) {
+    const time = n * d.dt;
+    support.frame(time, f);
+    if (isWalker) {
+      pathAt(m.speed * time, path);
+      grounded(f, path[0], path[1], path[2], 0, 1, out);
+    } else if (kind === 'hopper') {
+      hopAt(n, hopOut);
+      pathAt(hopOut[0], path);
+      grounded(f, path[0], path[1], path[2], hopOut[1], hopOut[2], out);
+    } else if (kind === 'flyer') {
+      pathAt(m.speed * time, path);
+      out[0] = path[0]; out[1] = m.altitude - m.groundY; out[2] = path[1]; out[3] = pcos(path[2]); out[4] = psin(path[2]); out[5] = 1;
+    } else if (kind === 'swimmer') {
+      pathAt(m.speed * time, path);
+      out[0] = path[0]; out[1] = swim[0]; out[2] = path[1]; out[3] = pcos(path[2]); out[4] = psin(path[2]); out[5] = 1;
+    } else {
+      grounded(f, pos[0], pos[2], -theta0, 0, 1, out);
+    }
+  }
+
+  /** Creature-local → world: p + R_yaw(S·x), S = diag(1/√s, s, 1/√s). */
+  function toWorldRoot(r, x0, x1, x2, out, o) {
+    const c = r[3], s = r[4], squash = r[5];
+    const k = 1 / Math.sqrt(squash);
+    const vx = x0 * k, vy = x1 * squash, vz = x2 * k;
+    out[o] = r[0] + (c * vx + s * vz);
+    out[o + 1] = r[1] + vy;
+    out[o + 2] = r[2] + (-s * vx + c * vz);
+  }
+
+  function toLocalRoot(r, x0, x1, x2, out, o) {
+    const c = r[3], s = r[4], squash = r[5];
+    const vx = x0 - r[0], vy = x1 - r[1], vz = x2 - r[2];
+    const sq = Math.sqrt(squash);
+    out[o] = (c * vx - s * vz) * sq;
+    out[o + 1] = vy / squash;
+    out[o + 2] = (s * vx + c * vz) * sq;
+  }
+
+  // --- one tick --------------------------------------------------------------------------------------
+
+  function update(n, integrate) {
+    const time = n * d.dt;
+    if (kind === 'swimmer') swimStep(n, integrate);
+    rootAt(n, frame, root);
+    if (kind === 'hopper') hopGates(n);
+    basePose(time);
+    if (L) gait(n, integrate);
+    if (m.ropes.length) ropes(integrate);
+  }
+
+  function swimStep(n, integrate) {
+    const time = n * d.dt;
+    pathAt(m.speed * time, path);
+    water.sample(path[0], path[1], time, sample);
+    const eta = sample.freeSurfacePoint[1];
+    const tgt = eta - d.swimDepth - m.centreY;
+    const tv = sample.geometricNormalVelocityMps[0] / sample.freeSurfaceNormal[1];
+    if (!integrate) { swim[0] = tgt; swim[1] = tv; }
+    else {
+      const om = d.swimOmega;
+      const acc = om * om * (tgt - swim[0]) + 2 * om * (tv - swim[1]);
+      swim[1] = swim[1] + acc * d.dt;
+      swim[0] = swim[0] + swim[1] * d.dt;
+    }
+    if (hasCurrent) {
+      centre[0] = centre[0] + sample.materialCurrentVelocityMps[0] * d.dt;
+      centre[2] = centre[2] + sample.materialCurrentVelocityMps[2] * d.dt;
+    }
+    if (time >= 2) gv[G.swimTracking] = Math.max(gv[G.swimTracking], Math.abs(swim[0] - tgt));
+  }
+
+  function hopGates(n) {
+    const squash = root[5];
+    const k = 1 / Math.sqrt(squash);
+    gv[G.squashDet] = Math.max(gv[G.squashDet], Math.abs(k * squash * k - 1));
+    if (n % d.hopCycle === d.hopIdle + d.crouch + d.halfAir) {
+      hopAt(n, hopOut);
+      gv[G.apexError] = Math.max(gv[G.apexError], Math.abs(hopOut[1] - d.apex));
+      gv[G.apexSquash] = squash;
+    }
+  }
+
+  function basePose(time) {
+    hasLocal.fill(0);
+    if (kind === 'flyer') {
+      for (let i = 0; i < m.roots.length; i++) { const r = m.roots[i]; locals[4 * r] = 0; locals[4 * r + 1] = 0; locals[4 * r + 2] = d.bankHalfSin; locals[4 * r + 3] = d.bankHalfCos; hasLocal[r] = 1; }
+      const flap = psin(2 * Math.PI * d.flapHz * time);
+      for (let i = 0; i < m.wings.length; i++) { const w = m.wings[i]; axisAngle(0, 0, 1, w.sign * w.amplitude * flap, locals, 4 * w.slot); hasLocal[w.slot] = 1; }
+    } else if (kind === 'swimmer' && d.undulationHz > 0) {
+      const angle = m.undulation * psin(2 * Math.PI * d.undulationHz * time);
+      for (let i = 0; i < m.roots.length; i++) { const r = m.roots[i]; axisAngle(0, 1, 0, angle, locals, 4 * r); hasLocal[r] = 1; }
+    }
+    for (let k = 0; k < m.order.length; k++) {
+      const s = m.order[k];
+      if (!hasLocal[s]) { locals[4 * s] = 0; locals[4 * s + 1] = 0; locals[4 * s + 2] = 0; locals[4 * s + 3] = 1; }
+      const pv = m.pivot[s];
+      rotate(locals, 4 * s, pv[0], pv[1], pv[2], turned, 0);
+      const ax = pv[0] - turned[0], ay = pv[1] - turned[1], az = pv[2] - turned[2];
+      const p = m.parent[s];
+      if (p < 0) {
+        quats[4 * s] = locals[4 * s]; quats[4 * s + 1] = locals[4 * s + 1]; quats[4 * s + 2] = locals[4 * s + 2]; quats[4 * s + 3] = locals[4 * s + 3];
+        trans[3 * s] = ax; trans[3 * s + 1] = ay; trans[3 * s + 2] = az;
+      } else {
+        mul(quats, 4 * p, locals, 4 * s, quats, 4 * s);
+        rotate(quats, 4 * p, ax, ay, az, turned, 0);
+        trans[3 * s] = turned[0] + trans[3 * p]; trans[3 * s + 1] = turned[1] + trans[3 * p + 1]; trans[3 * s + 2] = turned[2] + trans[3 * p + 2];
+      }
+    }
+  }
+
+  // --- legs --------------------------------------------------------------------------------------------
+
+  function homeAt(leg, n, out) {
+    rootAt(n, frame2, root2);
+    toWorldRoot(root2, leg.foot[0], leg.foot[1], leg.foot[2], v3, 0);
+    toLocal(frame2, v3[0], v3[1], v3[2], out, 0);
+    out[1] = 0;
+  }
+
+  function initialPlant(leg, i) {
+    homeAt(leg, 0, home);
+    if (m.speed <= 0) { plant[3 * i] = home[0]; plant[3 * i + 1] = 0; plant[3 * i + 2] = home[2]; return; }
+    const lead = m.constants.stepLead * m.stepLength;
+    const back = m.speed * d.dt * (d.cycle - d.swing - leg.group * d.window);
+    pathAt(0, path);
+    const psi = path[2];
+    const offset = lead - back;
+    plant[3 * i] = home[0] + psin(psi) * offset; plant[3 * i + 1] = 0; plant[3 * i + 2] = home[2] + pcos(psi) * offset;
+  }
+
+  /** Two-bone IK into the leg's slots (motion/ik.py); ik[0..2] knee, ik[3..5] foot, ik[6] clamped, ik[7] residual. */
+  function solveLeg(leg, tx, ty, tz) {
+    const hip = leg.hip, knee0 = leg.knee, foot0 = leg.foot, hint = leg.hint, a = leg.a, b = leg.b;
+    const dx = tx - hip[0], dy = ty - hip[1], dz = tz - hip[2];
+    const dist = Math.sqrt(dx * dx + dy * dy + dz * dz);
+    let ux = 0, uy = -1, uz = 0;
+    if (dist !== 0) { ux = dx / dist; uy = dy / dist; uz = dz / dist; }
+    const reach = Math.min(Math.max(dist, leg.reachMin), leg.reachMax);
+    gramSchmidt(hint[0], hint[1], hint[2], ux, uy, uz, w3, 0);
+    let cosA = (a * a + reach * reach - b * b) / (2 * a * reach);
+    cosA = Math.min(Math.max(cosA, -1), 1);
+    const sinA = Math.sqrt(1 - cosA * cosA);
+    const kx = hip[0] + a * (cosA * ux + sinA * w3[0]);
+    const ky = hip[1] + a * (cosA * uy + sinA * w3[1]);
+    const kz = hip[2] + a * (cosA * uz + sinA * w3[2]);
+    const fx = hip[0] + reach * ux, fy = hip[1] + reach * uy, fz = hip[2] + reach * uz;
+    // thigh: rest frame (0..5), posed frame (6..11)
+    normalizeInto(knee0[0] - hip[0], knee0[1] - hip[1], knee0[2] - hip[2], frames, 0);
+    gramSchmidt(hint[0], hint[1], hint[2], frames[0], frames[1], frames[2], frames, 3);
+    normalizeInto(kx - hip[0], ky - hip[1], kz - hip[2], frames, 6);
+    gramSchmidt(hint[0], hint[1], hint[2], frames[6], frames[7], frames[8], frames, 9);
+    const up = leg.upper, lo = leg.lower;
+    fromFrames(frames, quats, 4 * up);
+    rotate(quats, 4 * up, hip[0], hip[1], hip[2], turned, 0);
+    trans[3 * up] = hip[0] - turned[0]; trans[3 * up + 1] = hip[1] - turned[1]; trans[3 * up + 2] = hip[2] - turned[2];
+    normalizeInto(foot0[0] - knee0[0], foot0[1] - knee0[1], foot0[2] - knee0[2], frames, 0);
+    gramSchmidt(hint[0], hint[1], hint[2], frames[0], frames[1], frames[2], frames, 3);
+    normalizeInto(fx - kx, fy - ky, fz - kz, frames, 6);
+    gramSchmidt(hint[0], hint[1], hint[2], frames[6], frames[7], frames[8], frames, 9);
+    fromFrames(frames, quats, 4 * lo);
+    rotate(quats, 4 * lo, knee0[0], knee0[1], knee0[2], turned, 0);
+    trans[3 * lo] = kx - turned[0]; trans[3 * lo + 1] = ky - turned[1]; trans[3 * lo + 2] = kz - turned[2];
+    ik[0] = kx; ik[1] = ky; ik[2] = kz; ik[3] = fx; ik[4] = fy; ik[5] = fz;
+    ik[6] = reach !== dist ? 1 : 0;
+    const thigh = Math.hypot(kx - hip[0], ky - hip[1], kz - hip[2]);
+    const shin = Math.hypot(fx - kx, fy - ky, fz - kz);
+    ik[7] = Math.max(Math.abs(thigh - a), Math.abs(shin - b)) / (a + b);
+  }
+
+  function gait(n, integrate) {
+    const stepLength = m.stepLength;
+    const lead = m.constants.stepLead * stepLength;
+    const phase = n % d.cycle;
+    let swinging = 0;
+    for (let i = 0; i < L; i++) {
+      const leg = m.legs[i];
+      const o = 3 * i;
+      if (!integrate) { planted[i] = 1; initialPlant(leg, i); }
+      else if (!planted[i] && n - liftTick[i] >= d.swing) {
+        planted[i] = 1; plant[o] = swingTo[o]; plant[o + 1] = swingTo[o + 1]; plant[o + 2] = swingTo[o + 2];
+      }
+      if (planted[i] && integrate) {
+        homeAt(leg, n, home);
+        let du = home[0] - plant[o], dw = home[2] - plant[o + 2];
+        const lag = Math.sqrt(du * du + dw * dw);
+        const k = phase - leg.group * d.window;
+        if (lag > stepLength && k >= 0 && k <= d.window - d.swing) {
+          homeAt(leg, n + d.swing, ahead);
+          du = ahead[0] - plant[o]; dw = ahead[2] - plant[o + 2];
+          const dl = Math.sqrt(du * du + dw * dw);
+          planted[i] = 0; liftTick[i] = n;
+          swingFrom[o] = plant[o]; swingFrom[o + 1] = plant[o + 1]; swingFrom[o + 2] = plant[o + 2];
+          swingTo[o] = ahead[0]; swingTo[o + 1] = 0; swingTo[o + 2] = ahead[2];
+          if (dl > 0) { swingTo[o] = ahead[0] + du / dl * lead; swingTo[o + 2] = ahead[2] + dw / dl * lead; }
+          gv[G.steps] += 1;
+        }
+      }
+      if (planted[i]) { local[0] = plant[o]; local[1] = plant[o + 1]; local[2] = plant[o + 2]; }
+      else {
+        swinging += 1;
+        const tau = (n - liftTick[i]) / d.swing;
+        const sigma = tau * tau * (3 - 2 * tau);
+        local[0] = swingFrom[o] + (swingTo[o] - swingFrom[o]) * sigma;
+        local[1] = m.stepHeight * (4 * tau * (1 - tau));
+        local[2] = swingFrom[o + 2] + (swingTo[o + 2] - swingFrom[o + 2]) * sigma;
+      }
+      toWorld(frame, local[0], local[1], local[2], v3, 0);
+      toLocalRoot(root, v3[0], v3[1], v3[2], target, 0);
+      solveLeg(leg, target[0], target[1], target[2]);
+      const span = leg.a + leg.b;
+      gv[G.ikResidual] = Math.max(gv[G.ikResidual], ik[7]);
+      rotate(quats, 4 * leg.lower, leg.foot[0], leg.foot[1], leg.foot[2], v3, 0);
+      const lo = 3 * leg.lower;
+      const drawnX = v3[0] + trans[lo], drawnY = v3[1] + trans[lo + 1], drawnZ = v3[2] + trans[lo + 2];
+      gv[G.drawnFoot] = Math.max(gv[G.drawnFoot], Math.hypot(drawnX - ik[3], drawnY - ik[4], drawnZ - ik[5]) / span);
+      if (ik[6]) gv[G.clampedTicks] += 1;
+      else if (planted[i]) {
+        toWorldRoot(root, drawnX, drawnY, drawnZ, v3, 0);
+        toLocal(frame, v3[0], v3[1], v3[2], w3, 0);
+        gv[G.plantDrift] = Math.max(gv[G.plantDrift], Math.hypot(w3[0] - plant[o], w3[1] - plant[o + 1], w3[2] - plant[o + 2]) / span);
+        gv[G.plantedSamples] += 1;
+      }
+    }
+    if (L === 2 && swinging === 2) gv[G.bothSwingTicks] += 1;
+  }
+
+  // --- ropes -------------------------------------------------------------------------------------------
+
+  function anchorPoint(rope, j, out, o) {
+    const p = rope.parent;
+    const x = rope.rest[j];
+    rotate(quats, 4 * p, x[0], x[1], x[2], out, o);
+    out[o] += trans[3 * p]; out[o + 1] += trans[3 * p + 1]; out[o + 2] += trans[3 * p + 2];
+  }
+
+  function ropes(integrate) {
+    const c = m.constants;
+    if (!integrate) {
+      m.ropes.forEach((rope, r) => {
+        for (let j = 0; j < rope.rest.length; j++) {
+          anchorPoint(rope, j, v3, 0);
+          toWorldRoot(root, v3[0], v3[1], v3[2], nodes[r], 3 * j);
+          prevNodes[r][3 * j] = nodes[r][3 * j]; prevNodes[r][3 * j + 1] = nodes[r][3 * j + 1]; prevNodes[r][3 * j + 2] = nodes[r][3 * j + 2];
+        }
+      });
+    }
+    gravity.at(tick * d.dt, grav);
+    const substeps = c.ropeSubsteps, passes = c.ropePasses, keep = 1 - c.ropeDamping;
+    const h = d.dt / substeps;
+    const gx = grav[0] * h * h, gy = grav[1] * h * h, gz = grav[2] * h * h;
+    for (let r = 0; r < m.ropes.length; r++) {
+      const rope = m.ropes[r];
+      const cur = nodes[r], prev = prevNodes[r];
+      const count = rope.rest.length;
+      anchorPoint(rope, 0, anchorLocal, 0);
+      toWorldRoot(root, anchorLocal[0], anchorLocal[1], anchorLocal[2], anchorWorld, 0);
+      const seg = rope.segment;
+      if (integrate) {
+        for (let sub = 0; sub < substeps; sub++) {
+          for (let k = 0; k < 3; k++) { cur[k] = anchorWorld[k]; prev[k] = anchorWorld[k]; }
+          for (let j = 1; j < count; j++) {
+            const o = 3 * j;
+            const x0 = cur[o], x1 = cur[o + 1], x2 = cur[o + 2];
+            const vx = (x0 - prev[o]) * keep, vy = (x1 - prev[o + 1]) * keep, vz = (x2 - prev[o + 2]) * keep;
+            prev[o] = x0; prev[o + 1] = x1; prev[o + 2] = x2;
+            cur[o] = x0 + vx + gx; cur[o + 1] = x1 + vy + gy; cur[o + 2] = x2 + vz + gz;
+          }
+          for (let pass = 0; pass < passes; pass++) {
+            for (let j = 0; j < count - 1; j++) {
+              const a = 3 * j, b = a + 3;
+              const dx = cur[b] - cur[a], dy = cur[b + 1] - cur[a + 1], dz = cur[b + 2] - cur[a + 2];
+              const dist = Math.sqrt(dx * dx + dy * dy + dz * dz);
+              if (dist === 0) continue;
+              const f = (dist - seg) / dist;
+              if (j === 0) {
+                cur[b] = cur[b] - dx * f; cur[b + 1] = cur[b + 1] - dy * f; cur[b + 2] = cur[b + 2] - dz * f;
+              } else {
+                const hf = 0.5 * f;
+                cur[a] = cur[a] + dx * hf; cur[a + 1] = cur[a + 1] + dy * hf; cur[a + 2] = cur[a + 2] + dz * hf;
+                cur[b] = cur[b] - dx * hf; cur[b + 1] = cur[b + 1] - dy * hf; cur[b + 2] = cur[b + 2] - dz * hf;
+              }
+            }
+          }
+        }
+      }
+      for (let j = 0; j < count; j++) toLocalRoot(root, cur[3 * j], cur[3 * j + 1], cur[3 * j + 2], localNodes, 3 * j);
+      const rest = rope.rest;
+      // Segment frames by parallel transport down the chain (motion/simulate.py): each turns by the bend
+      // from the one before, the first from its parent's, so the twist is continuous and well conditioned.
+      normalizeInto(rest[1][0] - rest[0][0], rest[1][1] - rest[0][1], rest[1][2] - rest[0][2], e1, 0);
+      rotate(quats, 4 * rope.parent, e1[0], e1[1], e1[2], e0, 0);
+      let prevSlot = rope.parent;
+      for (let j = 0; j < rope.slots.length; j++) {
+        const slot = rope.slots[j];
+        const a = rest[j];
+        const o = 3 * j;
+        normalizeInto(localNodes[o + 3] - localNodes[o], localNodes[o + 4] - localNodes[o + 1], localNodes[o + 5] - localNodes[o + 2], e1, 0);
+        fromTo(e0[0], e0[1], e0[2], e1[0], e1[1], e1[2], q, 0);
+        mul(q, 0, quats, 4 * prevSlot, quats, 4 * slot);
+        prevSlot = slot;
+        e0[0] = e1[0]; e0[1] = e1[1]; e0[2] = e1[2];
+        rotate(quats, 4 * slot, a[0], a[1], a[2], turned, 0);
+        trans[3 * slot] = localNodes[o] - turned[0]; trans[3 * slot + 1] = localNodes[o + 1] - turned[1]; trans[3 * slot + 2] = localNodes[o + 2] - turned[2];
+      }
+      const s0 = rope.slots[0];
+      rotate(quats, 4 * s0, rest[0][0], rest[0][1], rest[0][2], turned, 0);
+      const err = Math.hypot(turned[0] + trans[3 * s0] - anchorLocal[0], turned[1] + trans[3 * s0 + 1] - anchorLocal[1], turned[2] + trans[3 * s0 + 2] - anchorLocal[2]);
+      gv[G.ropeAnchor] = Math.max(gv[G.ropeAnchor], err / m.bodyScale);
+    }
+  }
+
+  // --- public ------------------------------------------------------------------------------------------
+
+  function reset() {
+    const radius = m.pathRadius;
+    centre[0] = pos[0] - radius * pcos(theta0);
+    centre[1] = pos[1];
+    centre[2] = pos[2] - radius * psin(theta0);
+    tick = 0;
+    planted.fill(1); plant.fill(0); swingFrom.fill(0); swingTo.fill(0); liftTick.fill(0);
+    swim.fill(0);
+    resetGates();
+    update(0, false);
+    prevQuats.set(quats); prevTrans.set(trans); prevRoot.set(root);
+  }
+
+  const motion = {
+    data: m, derived: d, kind, quats, trans, root, prevQuats, prevTrans, prevRoot, nodes, support, gravity, water,
+    get gates() { return readGates(); },
+    get tick() { return tick; },
+    reset,
+    step() {
+      prevQuats.set(quats); prevTrans.set(trans); prevRoot.set(root);
+      tick += 1;
+      update(tick, true);
+    },
+    stepTicks(n = 1) { for (let k = 0; k < n; k++) motion.step(); },
+    seekTick(n) {
+      if (!Number.isInteger(n) || n < 0) throw new Error(`seekTick: a non-negative integer (got ${n})`);
+      reset();
+      motion.stepTicks(n);
+    },
+    /** The render pose between the previous and the current fixed step (motion/driver.py): position and
+     * squash lerped, heading (cos, sin) lerped and renormalised, quaternions nlerped on the previous one's
+     * hemisphere. */
+    renderPose(alpha, outQuats, outTrans, outRoot) {
+      const c = prevRoot[3] + (root[3] - prevRoot[3]) * alpha;
+      const s = prevRoot[4] + (root[4] - prevRoot[4]) * alpha;
+      const n = Math.sqrt(c * c + s * s);
+      outRoot[0] = prevRoot[0] + (root[0] - prevRoot[0]) * alpha;
+      outRoot[1] = prevRoot[1] + (root[1] - prevRoot[1]) * alpha;
+      outRoot[2] = prevRoot[2] + (root[2] - prevRoot[2]) * alpha;
+      outRoot[3] = c / n;
+      outRoot[4] = s / n;
+      outRoot[5] = prevRoot[5] + (root[5] - prevRoot[5]) * alpha;
+      for (let s = 0; s < S; s++) {
+        const o = 4 * s;
+        const sign = prevQuats[o] * quats[o] + prevQuats[o + 1] * quats[o + 1] + prevQuats[o + 2] * quats[o + 2] + prevQuats[o + 3] * quats[o + 3] < 0 ? -1 : 1;
+        const x = prevQuats[o] + (sign * quats[o] - prevQuats[o]) * alpha;
+        const y = prevQuats[o + 1] + (sign * quats[o + 1] - prevQuats[o + 1]) * alpha;
+        const z = prevQuats[o + 2] + (sign * quats[o + 2] - prevQuats[o + 2]) * alpha;
+        const w = prevQuats[o + 3] + (sign * quats[o + 3] - prevQuats[o + 3]) * alpha;
+        const n = Math.sqrt(x * x + y * y + z * z + w * w);
+        outQuats[o] = x / n; outQuats[o + 1] = y / n; outQuats[o + 2] = z / n; outQuats[o + 3] = w / n;
+        for (let k = 0; k < 3; k++) outTrans[3 * s + k] = prevTrans[3 * s + k] + (trans[3 * s + k] - prevTrans[3 * s + k]) * alpha;
+      }
+    },
+    /** Root, every slot's quaternion and translation, rope nodes (what parity compares); allocates. */
+    stateVector() {
+      const out = Array.from(root);
+      for (let s = 0; s < S; s++) out.push(...quats.subarray(4 * s, 4 * s + 4), ...trans.subarray(3 * s, 3 * s + 3));
+      for (const n of nodes) out.push(...n);
+      return out;
+    },
+    /** FNV-1a over the tick and the float64 state (state vector, previous rope nodes, feet, swimmer). */
+    stateHash() {
+      const values = motion.stateVector();
+      for (const n of prevNodes) values.push(...n);
+      for (let i = 0; i < L; i++) {
+        values.push(planted[i], ...plant.subarray(3 * i, 3 * i + 3), ...swingFrom.subarray(3 * i, 3 * i + 3), ...swingTo.subarray(3 * i, 3 * i + 3), liftTick[i]);
+      }
+      values.push(swim[0], swim[1], centre[0], centre[2]);
+      return hashBytes(new Uint8Array(Float64Array.from(values).buffer), tick);
+    },
+  };
+  reset();
+  return motion;
+}

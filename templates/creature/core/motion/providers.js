@@ -1,0 +1,135 @@
+// Injected providers, the same built-ins as creaturegen's Python reference (motion/providers.py).
+// Locomotion never owns the world: gait asks a SupportSurfaceProvider where the ground is and how it moves,
+// the swimmer asks a WaterSurfaceProvider for the channels it represents (an absent channel is absent,
+// never zero), and gravity comes from a provider and is never scaled by creature scale.
+// A support frame is 12 numbers: origin, tangent ex, outward normal ny, tangent ez; support-local
+// (u, h, w) maps to origin + u·ex + h·ny + w·ez.
+
+import { pcos, psin } from './trig.js';
+
+export const STANDARD_GRAVITY = 9.80665;
+export const SWIMMER_CHANNELS = Object.freeze(['freeSurfacePoint', 'freeSurfaceNormal', 'geometricNormalVelocityMps']);
+
+export function createGravity(vector = [0, -STANDARD_GRAVITY, 0]) {
+  const v = Float64Array.from(vector);
+  return { at(time, out) { out[0] = v[0]; out[1] = v[1]; out[2] = v[2]; return out; } };
+}
+
+export function toWorld(f, u, h, w, out, o) {
+  out[o] = f[0] + u * f[3] + h * f[6] + w * f[9];
+  out[o + 1] = f[1] + u * f[4] + h * f[7] + w * f[10];
+  out[o + 2] = f[2] + u * f[5] + h * f[8] + w * f[11];
+}
+
+export function toLocal(f, px, py, pz, out, o) {
+  const dx = px - f[0], dy = py - f[1], dz = pz - f[2];
+  out[o] = dx * f[3] + dy * f[4] + dz * f[5];
+  out[o + 1] = dx * f[6] + dy * f[7] + dz * f[8];
+  out[o + 2] = dx * f[9] + dy * f[10] + dz * f[11];
+}
+
+/** The SupportSurfaceProvider surface every built-in shares: closest point, outward normal, point
+ * velocity and acceleration, stable ids. Providers supply frame(), velocity() and acceleration(). */
+function support(name, supportId, frame, velocity, acceleration) {
+  const f = new Float64Array(12);
+  const local = new Float64Array(3);
+  return {
+    name, supportId,
+    frame,
+    velocity,
+    acceleration,
+    featureId() { return 0; },
+    closestPoint(time, p, out) {
+      frame(time, f);
+      toLocal(f, p[0], p[1], p[2], local, 0);
+      toWorld(f, local[0], 0, local[2], out, 0);
+      return out;
+    },
+    normal(time, p, out) {
+      frame(time, f);
+      out[0] = f[6]; out[1] = f[7]; out[2] = f[8];
+      return out;
+    },
+  };
+}
+
+const zero = (time, p, out) => { out[0] = 0; out[1] = 0; out[2] = 0; return out; };
+
+export function createFlatGround() {
+  return support('flat', 1, (time, out) => {
+    out.fill(0); out[3] = 1; out[7] = 1; out[11] = 1; return out;
+  }, zero, zero);
+}
+
+/** A plane through the origin rising along +z by `angle` radians (default 10°). */
+export function createSlope(angle = 10 * (Math.PI / 180)) {
+  const c = pcos(angle), s = psin(angle);
+  return support('slope', 2, (time, out) => {
+    out.fill(0); out[3] = 1; out[7] = c; out[8] = -s; out[10] = s; out[11] = c; return out;
+  }, zero, zero);
+}
+
+/** The ground plane carried at constant velocity (m/s). */
+export function createTranslatingPlatform(velocity = [0.3, 0, 0.1]) {
+  const v = Float64Array.from(velocity);
+  return support('translating', 3, (time, out) => {
+    out.fill(0);
+    out[0] = v[0] * time; out[1] = v[1] * time; out[2] = v[2] * time;
+    out[3] = 1; out[7] = 1; out[11] = 1; return out;
+  }, (time, p, out) => { out[0] = v[0]; out[1] = v[1]; out[2] = v[2]; return out; }, zero);
+}
+
+/** The ground plane turning about the vertical through `centre` at `omega` rad/s. */
+export function createRotatingPlatform(centre = [0.5, 0, -0.4], omega = 0.35) {
+  const c0 = Float64Array.from(centre);
+  return support('rotating', 4, (time, out) => {
+    const a = omega * time;
+    const c = pcos(a), s = psin(a);
+    out[0] = c0[0]; out[1] = c0[1]; out[2] = c0[2];
+    out[3] = c; out[4] = 0; out[5] = -s; out[6] = 0; out[7] = 1; out[8] = 0; out[9] = s; out[10] = 0; out[11] = c;
+    return out;
+  }, (time, p, out) => {
+    out[0] = omega * (p[2] - c0[2]); out[1] = 0; out[2] = -omega * (p[0] - c0[0]); return out;
+  }, (time, p, out) => {
+    const w2 = omega * omega;
+    out[0] = -w2 * (p[0] - c0[0]); out[1] = 0; out[2] = -w2 * (p[2] - c0[2]); return out;
+  });
+}
+
+export function builtinSupports() {
+  return { flat: createFlatGround(), slope: createSlope(), translating: createTranslatingPlatform(), rotating: createRotatingPlatform() };
+}
+
+const WAVE_CHANNELS = ['freeSurfacePoint', 'geometricNormalVelocityMps', 'freeSurfaceNormal', 'waterColumnDepthMeters'];
+
+/** Two travelling sine waves, η = A1 sin(k1 x − w1 t) + A2 sin(k2 z − w2 t + 0.7). `channels` lists what
+ * it represents; sample() writes only those into `out` (one Float64Array per channel). */
+export function createAnalyticWater({
+  channels = WAVE_CHANNELS, waves = [[0.06, 1.3, 1.7], [0.04, 0.9, 1.1]], level = 0, depth = 4,
+} = {}) {
+  const present = Object.freeze(channels.filter((c) => WAVE_CHANNELS.includes(c)));
+  const [[a1, k1, w1], [a2, k2, w2]] = waves;
+  return {
+    channels: present,
+    createSample() {
+      return { freeSurfacePoint: new Float64Array(3), freeSurfaceNormal: new Float64Array(3), geometricNormalVelocityMps: new Float64Array(1), waterColumnDepthMeters: new Float64Array(1) };
+    },
+    sample(x, z, time, out) {
+      const p1 = k1 * x - w1 * time;
+      const p2 = k2 * z - w2 * time + 0.7;
+      const eta = level + a1 * psin(p1) + a2 * psin(p2);
+      const detaDt = -a1 * w1 * pcos(p1) - a2 * w2 * pcos(p2);
+      const gx = a1 * k1 * pcos(p1);
+      const gz = a2 * k2 * pcos(p2);
+      const inv = 1 / Math.sqrt(gx * gx + 1 + gz * gz);
+      for (const name of present) {
+        const v = out[name];
+        if (name === 'freeSurfacePoint') { v[0] = x; v[1] = eta; v[2] = z; }
+        else if (name === 'freeSurfaceNormal') { v[0] = -gx * inv; v[1] = inv; v[2] = -gz * inv; }
+        else if (name === 'geometricNormalVelocityMps') v[0] = detaDt * inv;
+        else v[0] = eta + depth;
+      }
+      return out;
+    },
+  };
+}

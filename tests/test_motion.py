@@ -1,0 +1,145 @@
+"""Locomotion: the Python reference's gates on every example and support surface, determinism, refused
+tiers, and the generated JS core against the reference (node --test) on every buildable example.
+
+The gates run on the beetle too: locomotion needs only the rig, not its surface (issue 4 keeps the beetle's
+package from building, so it is left out of the Node parity only).
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import re
+import shutil
+import subprocess
+from pathlib import Path
+from typing import Any
+
+import pytest
+
+from conftest import CREATURE_EXAMPLES, EXAMPLES, REPO, build_example
+from creaturegen.motion.parity import motion_reference
+from creaturegen.motion.providers import SWIMMER_CHANNELS, AnalyticWater, RotatingPlatform, builtin_supports
+from creaturegen.motion.rig import WALKERS, build_motion
+from creaturegen.motion.simulate import Motion, TierRefusedError
+from creaturegen.rig import compile_rig
+from creaturegen.spec.gate import load_spec
+from creaturegen.surface.skeleton import build_skeleton
+
+EVERY_EXAMPLE = [*CREATURE_EXAMPLES, "beetle.json"]
+TICKS = 1000
+
+
+def motion_data(name: str) -> dict[str, Any]:
+    spec = load_spec(EXAMPLES / name)
+    rig = compile_rig(spec)
+    return build_motion(spec, rig, build_skeleton(spec, rig))
+
+
+def run(data: dict[str, Any], support: str, ticks: int = TICKS) -> Motion:
+    motion = Motion(data, support=builtin_supports()[support], water=AnalyticWater(), seed=7)
+    motion.step_ticks(ticks)
+    return motion
+
+
+@pytest.mark.parametrize("name", EVERY_EXAMPLE)
+def test_gates_on_every_support(name: str) -> None:
+    data = motion_data(name)
+    kind = data["type"]
+    for support in builtin_supports():
+        g = run(data, support).gates
+        where = f"{name} on {support}"
+        assert g.plant_drift <= 1e-9, f"{where}: planted-foot drift {g.plant_drift:.3g} x leg length"
+        assert g.ik_residual <= 1e-12, f"{where}: IK length residual {g.ik_residual:.3g}"
+        assert g.drawn_foot <= 1e-9, f"{where}: drawn foot vs IK foot {g.drawn_foot:.3g}"
+        assert g.rope_anchor <= 1e-12, f"{where}: rope anchor error {g.rope_anchor:.3g} x L"
+        if kind in WALKERS:
+            assert g.steps > 0, f"{where}: no foot ever stepped"
+            assert g.planted_samples > 0
+            assert g.clamped_ticks <= 0.01 * len(data["legs"]) * TICKS, f"{where}: {g.clamped_ticks} clamped"
+        if kind == "biped":
+            assert g.both_swing_ticks == 0, f"{where}: both feet in swing on {g.both_swing_ticks} ticks"
+        if kind == "hopper":
+            assert g.apex_error <= 1e-9, f"{where}: hop apex height error {g.apex_error:.3g} m"
+            assert g.apex_squash == 1.0, f"{where}: squash at the apex tick is {g.apex_squash!r}"
+            assert g.squash_det <= 4e-16, f"{where}: squash determinant off by {g.squash_det:.3g}"
+        if kind == "swimmer":
+            assert 0.0 < g.swim_tracking < 0.09, f"{where}: swim tracking {g.swim_tracking:.3g} m after 2 s"
+
+
+def test_hop_air_time_is_physical_and_quantised() -> None:
+    data = motion_data("reference/hopper.json")
+    d = Motion(data).d
+    assert d.air == 2 * d.half_air, "the apex is sampled exactly at a tick"
+    air_s = d.air * d.dt
+    ideal = 2.0 * (2.0 * data["hopHeight"] / d.g) ** 0.5
+    assert abs(air_s - ideal) <= d.dt, (air_s, ideal)
+    assert abs(d.apex - 0.5 * d.g * (d.half_air * d.dt) ** 2) < 1e-15
+
+
+def test_gravity_is_never_scaled_by_creature_scale() -> None:
+    small = motion_data("moth.json")  # scale 0.6
+    assert Motion(small).d.g == pytest.approx(9.80665, abs=0.0)
+
+
+@pytest.mark.parametrize(
+    "name", ["reference/quadruped.json", "reference/hopper.json", "reference/swimmer.json"]
+)
+def test_seek_and_step_reach_the_same_state(name: str) -> None:
+    data = motion_data(name)
+    a = Motion(data, support=RotatingPlatform(), water=AnalyticWater(), seed=3)
+    b = Motion(data, support=RotatingPlatform(), water=AnalyticWater(), seed=3)
+    a.seek_tick(137)
+    for _ in range(137):
+        b.step()
+    assert a.state_hash() == b.state_hash()
+    b.step()
+    assert a.state_hash() != b.state_hash()
+
+
+def test_a_swimmer_without_a_required_channel_is_refused() -> None:
+    data = motion_data("reference/swimmer.json")
+    Motion(data, water=AnalyticWater())
+    for missing in SWIMMER_CHANNELS:
+        channels = tuple(c for c in AnalyticWater().channels if c != missing)
+        with pytest.raises(TierRefusedError, match=missing):
+            Motion(data, water=AnalyticWater(channels=channels))
+    with pytest.raises(TierRefusedError, match="no WaterSurfaceProvider"):
+        Motion(data)
+
+
+def test_the_gates_can_fail() -> None:
+    """A shin drawn 1 cm shorter than the IK solves for: the drawn foot leaves its plant, and both the
+    drawn-foot and the planted-drift gates see it."""
+    data = motion_data("reference/biped.json")
+    data["legs"][0]["foot"][1] += 0.01
+    g = run(data, "flat", 200).gates
+    assert g.drawn_foot > 1e-3
+    assert g.plant_drift > 1e-3
+
+
+def node() -> str:
+    found = shutil.which("node")
+    assert found, "node is required (install Node.js >= 18)"
+    return found
+
+
+@pytest.mark.parametrize("name", CREATURE_EXAMPLES)
+def test_js_core_matches_python(name: str, creature_out: Path, tmp_path: Path) -> None:
+    package = build_example(name, creature_out)
+    reference = motion_reference(motion_data(name))
+    reference["data"] = json.loads(json.dumps(motion_data(name)))
+    path = tmp_path / "motion-reference.json"
+    path.write_text(json.dumps(reference))
+    env = {**os.environ, "MOTION_CORE": str(package / "core" / "index.js"), "MOTION_REFERENCE": str(path)}
+    done = subprocess.run(
+        [node(), "--test", "--test-reporter=spec", str(REPO / "tests" / "js" / "motion_core.test.mjs")],
+        capture_output=True,
+        text=True,
+        check=False,
+        env=env,
+        timeout=300,
+    )
+    assert done.returncode == 0, done.stdout + done.stderr
+    assert re.search(r"\bpass 6\b", done.stdout), done.stdout
+    assert re.search(r"\bfail 0\b", done.stdout), done.stdout
