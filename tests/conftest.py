@@ -5,6 +5,8 @@ from __future__ import annotations
 import importlib
 import importlib.util
 import os
+import re
+import shutil
 import subprocess
 import sys
 from collections.abc import Iterator
@@ -82,6 +84,28 @@ def build_example(name: str, out_root: Path) -> Path:
         result = run_cli("build", str(spec), "-o", str(out_root))
         assert result.returncode == 0, result.stdout[-2000:] + result.stderr[-4000:]
     return package
+
+
+def node() -> str:
+    found = shutil.which("node")
+    assert found is not None, "node (20+) must be on PATH"
+    return found
+
+
+def run_node_tests(script: str, env: dict[str, str]) -> subprocess.CompletedProcess[str]:
+    """``node --test`` on tests/js/<script> with ``env`` added: the JS core against a Python reference.
+    Fails the caller's assertion unless every test passed."""
+    done = subprocess.run(
+        [node(), "--test", "--test-reporter=spec", str(REPO / "tests" / "js" / script)],
+        capture_output=True,
+        text=True,
+        check=False,
+        env={**os.environ, **env},
+        timeout=300,
+    )
+    assert done.returncode == 0, done.stdout + done.stderr
+    assert re.search(r"\bfail 0\b", done.stdout), done.stdout
+    return done
 
 
 def run_cli(*args: str, cwd: Path = REPO) -> subprocess.CompletedProcess[str]:

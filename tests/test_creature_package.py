@@ -10,9 +10,7 @@ from __future__ import annotations
 import hashlib
 import importlib.util
 import json
-import os
 import re
-import shutil
 import subprocess
 import sys
 from pathlib import Path
@@ -22,7 +20,7 @@ from typing import Any
 import numpy as np
 import pytest
 
-from conftest import EXAMPLES, REPO, run_cli
+from conftest import EXAMPLES, REPO, node, run_cli, run_node_tests
 from creaturegen import __version__, cli
 from creaturegen.creature import sway as sway_module
 from creaturegen.emit.lint import Finding, lint_package, lint_sources, shipped_sources
@@ -67,12 +65,6 @@ def tree(root: Path) -> dict[str, bytes]:
 
 def build(spec: Path, out: Path) -> subprocess.CompletedProcess[str]:
     return run_cli("build", str(spec), "-o", str(out))
-
-
-def node() -> str:
-    found = shutil.which("node")
-    assert found is not None, "node (20+) must be on PATH"
-    return found
 
 
 def built_package(spec: Path, out: Path) -> Path:
@@ -195,7 +187,8 @@ def test_deform_storage_layout_is_one_definition_in_python_and_js(hopper: Path) 
     from creaturegen.creature.plan import DEFORM_STRIDE
 
     js = (hopper / "tsl" / "deform.js").read_text()
-    assert f"export const DEFORM_STRIDE = {DEFORM_STRIDE};" in js
+    assert "export const DEFORM_STRIDE = CREATURE.deformStride;" in js
+    assert f'"deformStride": {DEFORM_STRIDE}' in (hopper / "core" / "data.js").read_text()
     workload = json.loads((hopper / "build-report.json").read_text())["workload"]
     assert workload["deformBytesPerBody"] == workload["vertices"] * DEFORM_STRIDE * 16
 
@@ -479,20 +472,8 @@ def test_python_reference_is_sane() -> None:
 def test_js_core_matches_python(hopper: Path, tmp_path: Path) -> None:
     reference = tmp_path / "reference.json"
     reference.write_text(json.dumps(python_reference(HOPPER)))
-    env = {
-        **os.environ,
-        "CREATURE_CORE": str(hopper / "core" / "index.js"),
-        "CREATURE_REFERENCE": str(reference),
-    }
-    done = subprocess.run(
-        [node(), "--test", "--test-reporter=spec", str(REPO / "tests" / "js" / "creature_core.test.mjs")],
-        capture_output=True,
-        text=True,
-        check=False,
-        env=env,
-        timeout=300,
-    )
-    assert done.returncode == 0, done.stdout + done.stderr
+    env = {"CREATURE_CORE": str(hopper / "core" / "index.js"), "CREATURE_REFERENCE": str(reference)}
+    done = run_node_tests("creature_core.test.mjs", env)
     assert re.search(r"\bpass 4\b", done.stdout), done.stdout
 
 

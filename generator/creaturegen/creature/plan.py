@@ -118,6 +118,7 @@ def build_plan(
         },
         "mesh": {"vertices": asset.vertex_count, "triangles": int(asset.indices.size // 3)},
         "debugModes": list(DEBUG_MODES),
+        "deformStride": DEFORM_STRIDE,
     }
     corrected = int(np.count_nonzero(skin[:, 1] > 0))
     plan: dict[str, Any] = {

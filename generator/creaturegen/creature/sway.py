@@ -29,6 +29,7 @@ import numpy.typing as npt
 
 from ..field import layout as col
 from ..field.primitives import slot_uses_round_cone
+from ..motion import quat as vq
 from ..rig import CompiledRig
 from ..surface.deform import Pose, joint_frame, quaternion_to_matrix
 from ..surface.skeleton import Skeleton
@@ -70,57 +71,27 @@ def instance_offset(seed: int) -> tuple[int, float]:
     return first % PERIOD_TICKS, second / 4294967296.0 * 2.0 * math.pi
 
 
-def _depth(parent: tuple[int, ...], slot: int) -> int:
-    depth = 0
-    while parent[slot] >= 0:
-        slot, depth = parent[slot], depth + 1
-    return depth
-
-
 def build_sway(rig: CompiledRig, skeleton: Skeleton) -> Sway:
-    parent = skeleton.parent
-    depth = [_depth(parent, s) for s in range(rig.slot_count)]
-    order = tuple(sorted(range(rig.slot_count), key=lambda s: (depth[s], s)))
+    depth = skeleton.depth
     axis = np.zeros((rig.slot_count, 3))
     for _, child in skeleton.joints:
         axis[child] = joint_frame(skeleton, rig.slots, child)[1]
     phase = np.array([PHASE_PER_DEPTH * d for d in depth], dtype=np.float64)
-    return Sway(parent, order, skeleton.pivot.copy(), axis, phase, math.radians(AMPLITUDE_DEG), PERIOD_TICKS)
+    return Sway(
+        skeleton.parent,
+        skeleton.order,
+        skeleton.pivot.copy(),
+        axis,
+        phase,
+        math.radians(AMPLITUDE_DEG),
+        PERIOD_TICKS,
+    )
 
 
 def _axis_angle(axis: F64, angle: float) -> F64:
     half = 0.5 * angle
     s = math.sin(half)
     return np.array([axis[0] * s, axis[1] * s, axis[2] * s, math.cos(half)])
-
-
-def _mul(a: F64, b: F64) -> F64:
-    """Quaternion product a ⊗ b, components (x, y, z, w), written out as the JS core writes it."""
-    ax, ay, az, aw = a
-    bx, by, bz, bw = b
-    return np.array(
-        [
-            aw * bx + ax * bw + ay * bz - az * by,
-            aw * by - ax * bz + ay * bw + az * bx,
-            aw * bz + ax * by - ay * bx + az * bw,
-            aw * bw - ax * bx - ay * by - az * bz,
-        ]
-    )
-
-
-def _rotate(q: F64, v: F64) -> F64:
-    """R(q)·v by ``v + 2w(u×v) + 2u×(u×v)``, the JS core's formula."""
-    x, y, z, w = q
-    cx = y * v[2] - z * v[1]
-    cy = z * v[0] - x * v[2]
-    cz = x * v[1] - y * v[0]
-    return np.array(
-        [
-            v[0] + 2.0 * (w * cx + y * cz - z * cy),
-            v[1] + 2.0 * (w * cy + z * cx - x * cz),
-            v[2] + 2.0 * (w * cz + x * cy - y * cx),
-        ]
-    )
 
 
 def sway_transforms(sway: Sway, tick: int) -> tuple[F64, F64]:
@@ -137,9 +108,9 @@ def sway_transforms(sway: Sway, tick: int) -> tuple[F64, F64]:
         angle = sway.amplitude * math.sin(phase_of_tick + float(sway.phase[s]))
         local = _axis_angle(sway.axis[s], angle)
         pivot = sway.pivot[s]
-        turned = _rotate(local, pivot)
-        quats[s] = _mul(quats[p], local)
-        trans[s] = _rotate(quats[p], pivot - turned) + trans[p]
+        turned = np.array(vq.rotate(list(local), list(pivot)))
+        quats[s] = vq.mul(list(quats[p]), list(local))
+        trans[s] = np.array(vq.rotate(list(quats[p]), list(pivot - turned))) + trans[p]
     return quats, trans
 
 
@@ -155,8 +126,8 @@ def pose_rows(rig: CompiledRig, quats: F64, trans: F64) -> npt.NDArray[np.float3
     slots = rig.slots
     rows = np.zeros((rig.slot_count, POSE_ROWS, 4))
     for s in range(rig.slot_count):
-        rows[s, 0, :3] = _rotate(quats[s], slots[s, col.A]) + trans[s]
-        rows[s, 1, :3] = _rotate(quats[s], slots[s, col.B]) + trans[s]
+        rows[s, 0, :3] = np.array(vq.rotate(list(quats[s]), list(slots[s, col.A]))) + trans[s]
+        rows[s, 1, :3] = np.array(vq.rotate(list(quats[s]), list(slots[s, col.B]))) + trans[s]
     rows[:, 0, 3] = slots[:, col.RA]
     rows[:, 1, 3] = slots[:, col.RB]
     rows[:, 2, 0] = slots[:, col.K]

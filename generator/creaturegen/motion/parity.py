@@ -29,8 +29,8 @@ def run_case(data: dict[str, Any], support: str, seed: int) -> dict[str, Any]:
             motion.step()
         if tick in PARITY_TICKS:
             frames.append({"tick": tick, "state": motion.state_vector()})
-    prev_root, prev_quats, prev_trans = list(motion.root), [list(q) for q in motion.quats], motion.trans
-    prev_trans = [list(t) for t in prev_trans]
+    prev_root, prev_quats = list(motion.root), [list(q) for q in motion.quats]
+    prev_trans = [list(t) for t in motion.trans]
     motion.step()
     alpha = 0.375
     root = interpolate_root(prev_root, motion.root, alpha)

@@ -17,16 +17,8 @@ from .quat import Vec
 from .trig import pcos, psin
 
 STANDARD_GRAVITY: Final = 9.80665
-#: Water channels of the shared sample; the swimmer needs SWIMMER_CHANNELS and refuses the tier without them.
-WATER_CHANNELS: Final = (
-    "freeSurfacePoint",
-    "geometricNormalVelocityMps",
-    "freeSurfaceNormal",
-    "waterColumnDepthMeters",
-    "surfacePointVelocityMps",
-    "materialCurrentVelocityMps",
-    "densityKgPerM3",
-)
+#: Water channels the swimmer reads; without any of them the tier is refused. The shared sample also names
+#: waterColumnDepthMeters, surfacePointVelocityMps, materialCurrentVelocityMps and densityKgPerM3.
 SWIMMER_CHANNELS: Final = ("freeSurfacePoint", "freeSurfaceNormal", "geometricNormalVelocityMps")
 
 Frame = list[float]

@@ -41,7 +41,6 @@ SWIM_RESPONSE: Final = 1.0
 ROPE_SUBSTEPS: Final = 2
 ROPE_PASSES: Final = 4
 ROPE_DAMPING: Final = 0.02
-TICK_RATES: Final = (60, 120)
 
 WALKERS: Final = ("biped", "quadruped", "hexapod")
 
@@ -135,12 +134,6 @@ def build_motion(spec: CharacterSpec, rig: CompiledRig, skeleton: Skeleton) -> d
     else:
         ground = float(min(min(s[1] - s[3], s[5] - s[7]) for s in slots.tolist()))
     roots = [s for s in range(rig.slot_count) if skeleton.parent[s] < 0]
-    depth = [0] * rig.slot_count
-    for s in range(rig.slot_count):
-        walk = s
-        while skeleton.parent[walk] >= 0:
-            walk, depth[s] = skeleton.parent[walk], depth[s] + 1
-    order = sorted(range(rig.slot_count), key=lambda s: (depth[s], s))
     centre_y = sum(0.5 * (float(slots[r, 1]) + float(slots[r, 5])) for r in roots) / len(roots)
     fields = fields_of(loco)
     speed = float(fields.get("speed", 0.0))
@@ -167,7 +160,7 @@ def build_motion(spec: CharacterSpec, rig: CompiledRig, skeleton: Skeleton) -> d
         "wings": wings,
         "roots": roots,
         "parent": list(skeleton.parent),
-        "order": order,
+        "order": list(skeleton.order),
         "pivot": [_v(p) for p in skeleton.pivot],
         "constants": {
             "swingFroude": SWING_FROUDE,

@@ -35,9 +35,9 @@ from .providers import (
     to_world,
 )
 from .quat import Vec
+from .rig import WALKERS
 from .trig import pcos, psin
 
-WALKERS = ("biped", "quadruped", "hexapod")
 Z_AXIS = [0.0, 0.0, 1.0]
 Y_AXIS = [0.0, 1.0, 0.0]
 
@@ -310,17 +310,16 @@ class Motion:
 
     # --- legs ------------------------------------------------------------------------------------
 
-    def _home(self, leg: dict[str, Any], n: int) -> Vec:
-        """Support-local home of a foot at tick ``n``: the rest foot under the root, on the support."""
-        frame, root = self.root_at(n)
+    def _home(self, leg: dict[str, Any], frame: Frame, root: list[float]) -> Vec:
+        """Support-local home of a foot: the rest foot under ``root``, on the support ``frame``."""
         local = to_local(frame, self.to_world_root(root, leg["foot"]))
         return [local[0], 0.0, local[2]]
 
-    def _initial_plant(self, leg: dict[str, Any]) -> Vec:
+    def _initial_plant(self, leg: dict[str, Any], frame: Frame) -> Vec:
         """Where a steady gait would have this foot at tick 0: group g last landed (cycle − swing − g·W)
         ticks of travel ago at stepLead·s ahead of its home, so every group lifts as its window opens."""
         data, d = self.data, self.d
-        home = self._home(leg, 0)
+        home = self._home(leg, frame, self.root)
         if data["speed"] <= 0.0:
             return home
         lead = data["constants"]["stepLead"] * data["stepLength"]
@@ -337,16 +336,16 @@ class Motion:
         swinging = 0
         for leg, foot in zip(data["legs"], self.feet, strict=True):
             if not integrate:
-                foot.planted, foot.p = True, self._initial_plant(leg)
+                foot.planted, foot.p = True, self._initial_plant(leg, frame)
             elif not foot.planted and n - foot.n0 >= d.swing:
                 foot.planted, foot.p = True, list(foot.t)
             if foot.planted and integrate:
-                home = self._home(leg, n)
+                home = self._home(leg, frame, self.root)
                 du, dw = home[0] - foot.p[0], home[2] - foot.p[2]
                 lag = math.sqrt(du * du + dw * dw)
                 k = m - leg["group"] * d.window
                 if lag > step_length and 0 <= k <= d.window - d.swing:
-                    ahead = self._home(leg, n + d.swing)
+                    ahead = self._home(leg, *self.root_at(n + d.swing))
                     du, dw = ahead[0] - foot.p[0], ahead[2] - foot.p[2]
                     dl = math.sqrt(du * du + dw * dw)
                     foot.planted, foot.n0, foot.s = False, n, list(foot.p)
@@ -386,21 +385,21 @@ class Motion:
 
     # --- ropes -----------------------------------------------------------------------------------
 
-    def _anchor_points(self, rope: dict[str, Any]) -> list[Vec]:
-        """Rest points of the rope moved rigidly with its parent slot (creature-local)."""
+    def _anchor_point(self, rope: dict[str, Any], j: int) -> Vec:
+        """Rest point ``j`` of the rope moved rigidly with its parent slot (creature-local)."""
         q, t = self.quats[rope["parent"]], self.trans[rope["parent"]]
-        out = []
-        for x in rope["rest"]:
-            r = vq.rotate(q, x)
-            out.append([r[0] + t[0], r[1] + t[1], r[2] + t[2]])
-        return out
+        r = vq.rotate(q, rope["rest"][j])
+        return [r[0] + t[0], r[1] + t[1], r[2] + t[2]]
 
     def _ropes(self, integrate: bool) -> None:
         d, c = self.d, self.data["constants"]
         if not integrate:
             self.nodes, self.prev_nodes = [], []
             for rope in self.data["ropes"]:
-                world = [self.to_world_root(self.root, x) for x in self._anchor_points(rope)]
+                world = [
+                    self.to_world_root(self.root, self._anchor_point(rope, j))
+                    for j in range(len(rope["rest"]))
+                ]
                 self.nodes.append(world)
                 self.prev_nodes.append([list(x) for x in world])
         g = self.gravity.at(self.tick * d.dt)
@@ -409,7 +408,7 @@ class Motion:
         gx, gy, gz = g[0] * h * h, g[1] * h * h, g[2] * h * h
         for index, rope in enumerate(self.data["ropes"]):
             cur, prev = self.nodes[index], self.prev_nodes[index]
-            anchor_local = self._anchor_points(rope)[0]
+            anchor_local = self._anchor_point(rope, 0)
             anchor = self.to_world_root(self.root, anchor_local)
             seg = rope["segment"]
             if integrate:

@@ -35,6 +35,23 @@ class Skeleton:
         """(parent, child) pairs, in slot order."""
         return [(p, c) for c, p in enumerate(self.parent) if p >= 0]
 
+    @property
+    def depth(self) -> list[int]:
+        """Joints between each slot and its root (0 for roots)."""
+        out = []
+        for slot in range(len(self.parent)):
+            count, walk = 0, slot
+            while self.parent[walk] >= 0:
+                walk, count = self.parent[walk], count + 1
+            out.append(count)
+        return out
+
+    @property
+    def order(self) -> tuple[int, ...]:
+        """Slots parents first (by depth, then index): the order poses compose down the skeleton."""
+        depth = self.depth
+        return tuple(sorted(range(len(self.parent)), key=lambda s: (depth[s], s)))
+
     def neighbours(self, slot: int) -> set[int]:
         """The slot, its parent and its children: the slots a vertex of ``slot`` may blend with."""
         near = {slot}

@@ -2,16 +2,9 @@
 // Python reference (creature/sway.py): q_s = q_parent ⊗ axisAngle(axis_s, θ_s),
 // t_s = R(q_parent)(pivot_s − R(axisAngle) pivot_s) + t_parent, θ_s = A sin(2π (n mod P)/P + φ_s).
 
-/** R(q)·v by v + 2w(u×v) + 2u×(u×v); writes out[o..o+2]. */
-export function rotate(q, qo, vx, vy, vz, out, o) {
-  const x = q[qo], y = q[qo + 1], z = q[qo + 2], w = q[qo + 3];
-  const cx = y * vz - z * vy;
-  const cy = z * vx - x * vz;
-  const cz = x * vy - y * vx;
-  out[o] = vx + 2 * (w * cx + y * cz - z * cy);
-  out[o + 1] = vy + 2 * (w * cy + z * cx - x * cz);
-  out[o + 2] = vz + 2 * (w * cz + x * cy - y * cx);
-}
+import { rotate } from './motion/quat.js';
+
+export { rotate };
 
 /** Scratch space for one creature: per-slot quaternions and translations (float64), allocated once. */
 export function createPoseScratch(slotCount) {

@@ -13,7 +13,7 @@ import { bodyFunctions, layoutOf } from './body.js';
 import {
   DEFORM_STRIDE, createDeformKernel, deformStorage, deformView, dispatchDeform, vertexRecords,
 } from './deform.js';
-import { DEBUG_MODES, createBodyMaterial } from './material.js';
+import { checkDebugMode, createBodyMaterial } from './material.js';
 import { createShellMesh } from './shell.js';
 
 const SHIPPED_VARIANTS = ['off'];
@@ -121,11 +121,10 @@ export async function createCreaturePopulation(renderer, options = {}) {
   const corner = new THREE.Vector3();
   const box = new THREE.Box3();
   let tick = 0;
-  let mode = options.debugMode ?? 'off';
+  let mode = checkDebugMode(options.debugMode ?? 'off');
 
   const variantKey = (m) => [data.signatures.compilerSignature, data.signatures.topologySignature, data.tier, m, data.registers].join('|');
   function materialFor(page, m) {
-    if (!DEBUG_MODES.includes(m)) throw new Error(`debugMode: one of ${DEBUG_MODES.join(', ')} (got ${m})`);
     const key = `${variantKey(m === 'shell' ? 'off' : m)}|page${pages.indexOf(page)}`;
     if (!variants.has(key)) variants.set(key, createBodyMaterial(layout, page.pose, page.deformView, m === 'shell' ? 'off' : m));
     return variants.get(key);
@@ -320,7 +319,7 @@ export async function createCreaturePopulation(renderer, options = {}) {
     },
     /** Switch every page to debug mode `m` (a variant built on first use; 'off' is the shipped one). */
     setDebugMode(m) {
-      if (!DEBUG_MODES.includes(m)) throw new Error(`debugMode: one of ${DEBUG_MODES.join(', ')} (got ${m})`);
+      checkDebugMode(m);
       const rerun = kernelKind(m) !== kernelKind(mode);
       for (const page of pages) {
         showMode(page, m);

@@ -271,15 +271,15 @@ export function createMotion(data, lcg, { support = createFlatGround(), gravity 
 
   // --- legs --------------------------------------------------------------------------------------------
 
-  function homeAt(leg, n, out) {
-    rootAt(n, frame2, root2);
-    toWorldRoot(root2, leg.foot[0], leg.foot[1], leg.foot[2], v3, 0);
-    toLocal(frame2, v3[0], v3[1], v3[2], out, 0);
+  /** Support-local home of a foot: the rest foot under root r, on the support frame f. */
+  function homeIn(leg, f, r, out) {
+    toWorldRoot(r, leg.foot[0], leg.foot[1], leg.foot[2], v3, 0);
+    toLocal(f, v3[0], v3[1], v3[2], out, 0);
     out[1] = 0;
   }
 
   function initialPlant(leg, i) {
-    homeAt(leg, 0, home);
+    homeIn(leg, frame, root, home);
     if (m.speed <= 0) { plant[3 * i] = home[0]; plant[3 * i + 1] = 0; plant[3 * i + 2] = home[2]; return; }
     const lead = m.constants.stepLead * m.stepLength;
     const back = m.speed * d.dt * (d.cycle - d.swing - leg.group * d.window);
@@ -341,12 +341,13 @@ export function createMotion(data, lcg, { support = createFlatGround(), gravity 
         planted[i] = 1; plant[o] = swingTo[o]; plant[o + 1] = swingTo[o + 1]; plant[o + 2] = swingTo[o + 2];
       }
       if (planted[i] && integrate) {
-        homeAt(leg, n, home);
+        homeIn(leg, frame, root, home);
         let du = home[0] - plant[o], dw = home[2] - plant[o + 2];
         const lag = Math.sqrt(du * du + dw * dw);
         const k = phase - leg.group * d.window;
         if (lag > stepLength && k >= 0 && k <= d.window - d.swing) {
-          homeAt(leg, n + d.swing, ahead);
+          rootAt(n + d.swing, frame2, root2);
+          homeIn(leg, frame2, root2, ahead);
           du = ahead[0] - plant[o]; dw = ahead[2] - plant[o + 2];
           const dl = Math.sqrt(du * du + dw * dw);
           planted[i] = 0; liftTick[i] = n;

@@ -18,6 +18,7 @@ export const CREATURE = Object.freeze({
     "candidates",
     "shell"
   ],
+  "deformStride": 3,
   "fullProgram": 54,
   "gradientFloor": 1e-12,
   "kFloor": 0.00124,
@@ -3097,7 +3098,7 @@ export const CREATURE = Object.freeze({
     0
   ],
   "signatures": {
-    "compilerSignature": "908ab0d9915c5d35e8f5bfc2d52bb0df0506a59fc1bb273aaea89ce34e2aec2c",
+    "compilerSignature": "bc8d6ba29ca6c379a7b94d3d36986bedb40b3c8a50f729393f192cd998e74bc5",
     "geometryDigest": "400b0d18a2a9f6bbbfe5b441f89767f552a4f3b4c45a368d1129d632e1d2f4f1",
     "topologySignature": "d997bf5a05460ff68faead98d301d8766cd723bba06ded7b59f9e73102ccda75"
   },

@@ -6,10 +6,12 @@
 // evaluated twice in a frame (a vertex stage would re-run the whole path per pass, and per re-shaded
 // vertex on a rasteriser without a post-transform cache, such as SwiftShader).
 import { Fn, If, float, instanceIndex, instancedArray, int, storage, uniform, vec4 } from 'three/tsl';
+import { CREATURE } from '../core/data.js';
 import { bodyVertex } from './body.js';
 
-/** vec4 per drawn vertex: (position, distance), (gradient, accepted), (albedo, program). */
-export const DEFORM_STRIDE = 3;
+/** vec4 per drawn vertex: (position, distance), (gradient, accepted), (albedo, program); the plan's number,
+ * which the build report's deformBytesPerBody also uses. */
+export const DEFORM_STRIDE = CREATURE.deformStride;
 /** vec4 per rest vertex: (rest, 0), slots, weights, (centre of rotation, 0), (method, trust, program, 0). */
 export const RECORD_STRIDE = 5;
 

@@ -9,12 +9,20 @@ import {
   Fn, attribute, clamp, float, fract, instanceIndex, int, mix, normalLocal, normalize, select, sin,
   varyingProperty, vec3, vertexIndex,
 } from 'three/tsl';
+import { CREATURE } from '../core/data.js';
 import { DEFORM_STRIDE } from './deform.js';
 
-export const DEBUG_MODES = Object.freeze(['off', 'skin-only', 'distance', 'weights', 'normals', 'candidates', 'shell']);
+/** The runtime's debug views, as the build plan lists them. */
+export const DEBUG_MODES = Object.freeze([...CREATURE.debugModes]);
+
+/** Throws unless `mode` is one of DEBUG_MODES (every place a mode enters the runtime calls this). */
+export function checkDebugMode(mode) {
+  if (!DEBUG_MODES.includes(mode)) throw new Error(`debugMode: one of ${DEBUG_MODES.join(', ')} (got ${mode})`);
+  return mode;
+}
 
 // A stable colour per integer (debug views): fract of a sine hash.
-export const hashColour = (n) => vec3(fract(sin(n.mul(12.9898)).mul(43758.5453)), fract(sin(n.mul(78.233)).mul(12543.37)), fract(sin(n.mul(3.7719)).mul(9821.13)));
+const hashColour = (n) => vec3(fract(sin(n.mul(12.9898)).mul(43758.5453)), fract(sin(n.mul(78.233)).mul(12543.37)), fract(sin(n.mul(3.7719)).mul(9821.13)));
 
 /** Yaw about +y by the root row (cos, sin), as the JS core writes it. */
 export const rootRotate = (root1, v) => vec3(root1.x.mul(v.x).add(root1.y.mul(v.z)), v.y, root1.y.negate().mul(v.x).add(root1.x.mul(v.z)));
