@@ -38,7 +38,8 @@ help:
 	@echo "make lab      serve $(WEB_LAB)/ at http://$(LAB_HOST):$(LAB_PORT)/"
 	@echo "make bench    bench/results/field.json (candidates, analytic vs FD), frost.json (tiers, tiles, idle),"
 	@echo "              surface.json (narrow band vs dense, numpy vs wgpu, extraction, gates),"
-	@echo "              runtime.json (creature frame p50/p95 vs bodies, per-body cost, baseline vs 7P/K, spawns)"
+	@echo "              runtime.json (creature frame p50/p95 vs bodies, per-body cost, baseline vs 7P/K, spawns),"
+	@echo "              motion.json (locomotion core in Node: µs per creature per step, rope cost, allocation)"
 	@echo "make clean    remove build output and caches; distclean also removes .venv and node_modules"
 
 # --- setup ------------------------------------------------------------------------------------
@@ -100,6 +101,8 @@ bench: setup
 	$(VENV_PY) bench/surface.py --out bench/results/surface.json
 	@echo "==> runtime benchmark (creature population on WebGPU/SwiftShader, shipped vs forbidden baseline) into bench/results/runtime.json"
 	$(VENV_PY) bench/runtime.py --out bench/results/runtime.json
+	@echo "==> motion benchmark (locomotion core in Node: cost per step, rope cost, allocation) into bench/results/motion.json"
+	$(VENV_PY) bench/motion.py --out bench/results/motion.json
 
 # --- checks -----------------------------------------------------------------------------------
 

@@ -22,12 +22,15 @@ import pytest
 
 from conftest import EXAMPLES, REPO, node, run_cli, run_node_tests
 from creaturegen import __version__, cli
-from creaturegen.creature import sway as sway_module
+from creaturegen.creature import pose as pose_module
 from creaturegen.emit.lint import Finding, lint_package, lint_sources, shipped_sources
 from creaturegen.emit.render import to_json
 from creaturegen.emit.writer import header_text
 from creaturegen.field.primitives import slot_uses_round_cone
-from creaturegen.rig import CompiledRig, compile_rig
+from creaturegen.motion.providers import AnalyticWater
+from creaturegen.motion.rig import build_motion
+from creaturegen.motion.simulate import Motion
+from creaturegen.rig import compile_rig
 from creaturegen.spec import CharacterSpec, load_spec, slugify
 from creaturegen.surface.skeleton import build_skeleton
 
@@ -43,6 +46,7 @@ LAYOUT = (
     "core/data.js",
     "core/lcg.js",
     "core/pose.js",
+    "core/index.d.ts",
     "tsl/index.js",
     "assets/surface.glb",
     "assets/surface.json",
@@ -106,8 +110,11 @@ def test_package_json(hopper: Path) -> None:
     exports = package["exports"]
     assert {".", "./core", "./tsl"} <= set(exports)
     assert package["peerDependencies"] == {"three": ">=0.185.0 <0.186.0"}
-    main = exports["."]["default"] if isinstance(exports["."], dict) else exports["."]
-    for target in (package["main"], package["types"], main, exports["./core"], exports["./tsl"]):
+    targets = [package["main"], package["types"], exports["./tsl"]]
+    for entry in (exports["."], exports["./core"]):
+        assert set(entry) == {"types", "default"}, "typed entry points name their .d.ts"
+        targets += [entry["types"], entry["default"]]
+    for target in targets:
         assert (hopper / target).is_file(), target
     assert "dependencies" not in package, "three is a peer dependency; the package has no others"
 
@@ -176,7 +183,7 @@ def test_core_has_no_three(hopper: Path) -> None:
 
 def test_lint_finds_nothing_in_the_package(hopper: Path) -> None:
     sources = shipped_sources(hopper)
-    expected = {n for n in tree(hopper) if n.startswith(("core/", "tsl/")) and n.endswith(".js")}
+    expected = {n for n in tree(hopper) if n.startswith(("core/", "tsl/")) and n.endswith((".js", ".ts"))}
     assert set(sources) == expected
     findings = lint_package(hopper)
     assert findings == [], "\n".join(map(str, findings))
@@ -386,87 +393,68 @@ def test_invalid_spec_from_the_command_line(tmp_path: Path) -> None:
 
 # --- the JS core against the Python reference ----------------------------------------------------------
 
-TICKS = range(241)
-#: Ticks the closed form must also handle: negative ones and large ones (seek far ahead).
-EXTRA_TICKS = (-1, -119, -120, -241, 1_000_003, 2**31 + 5, 2**53 - 1)
-#: Seeds for LCG draws and instance offsets (negative and > 2^32 wrap like JS's `>>> 0`).
+#: Seeds for LCG draws and instance headings (negative and > 2^32 wrap like JS's `>>> 0`).
 SEEDS = (0, 1, 7, 4801, 2**31, 2**32 - 1, -1, 2**40 + 5)
-#: Seeds whose spawned instances are posed at every tick of TICKS.
+#: Seeds whose bodies are stepped tick by tick and written as pose rows at every tick of TICKS.
 POSED_SEEDS = (7, 4801, 2**32 - 1)
+TICKS = 240
 LCG_DRAWS = 16
 
 
-def _frame(rig: CompiledRig, sway: sway_module.Sway, tick: int, shift: int) -> dict[str, Any]:
-    quats, trans = sway_module.sway_transforms(sway, tick + shift)
-    rows = sway_module.pose_rows(rig, quats, trans)
-    return {
-        "tick": tick,
-        "quats": quats.ravel().tolist(),
-        "trans": trans.ravel().tolist(),
-        "rowBits": rows.ravel().view(np.uint32).tolist(),
-    }
-
-
 def python_reference(spec_path: Path) -> dict[str, Any]:
-    """What the JS core must reproduce, computed by creature/sway.py from the spec alone."""
+    """What the JS core must reproduce: LCG draws and headings (creature/pose.py), and the pose rows and
+    root rows of the locomotion reference (motion/simulate.py) at every tick, as float32 bit patterns."""
     spec = load_spec(spec_path)
     assert isinstance(spec, CharacterSpec)
     rig = compile_rig(spec)
-    sway = sway_module.build_sway(rig, build_skeleton(spec, rig))
+    data = build_motion(spec, rig, build_skeleton(spec, rig))
     lcg = []
     for seed in SEEDS:
         state, draws = seed % (1 << 32), []
         for _ in range(LCG_DRAWS):
-            state = sway_module.lcg_next(state)
+            state = pose_module.lcg_next(state)
             draws.append(state)
         lcg.append({"seed": seed, "draws": draws})
-    instances = []
-    for seed in SEEDS:
-        offset, yaw = sway_module.instance_offset(seed)
-        instances.append({"seed": seed, "tickOffset": offset, "yaw": yaw})
-    offsets = {i["seed"]: i["tickOffset"] for i in instances}
-    cases: list[dict[str, Any]] = [
-        {
-            "label": "rest instance",
-            "tickShift": 0,
-            "frames": [_frame(rig, sway, n, 0) for n in (*TICKS, *EXTRA_TICKS)],
-        }
-    ]
+    cases = []
     for seed in POSED_SEEDS:
-        shift = int(offsets[seed])
-        cases.append(
-            {
-                "label": f"seed {seed}",
-                "tickShift": shift,
-                "frames": [_frame(rig, sway, n, shift) for n in TICKS],
-            }
-        )
+        motion = Motion(data, water=AnalyticWater(), seed=seed)
+        frames = []
+        for tick in range(TICKS + 1):
+            if tick:
+                motion.step()
+            rows = np.concatenate(
+                [
+                    pose_module.pose_rows(rig, motion.quats, motion.trans).ravel(),
+                    pose_module.root_rows(motion.root).ravel(),
+                ]
+            )
+            frames.append({"tick": tick, "root": list(motion.root), "rowBits": rows.view(np.uint32).tolist()})
+        cases.append({"seed": seed, "frames": frames})
     return {
         "slotCount": rig.slot_count,
         "constants": {
-            "poseRows": sway_module.POSE_ROWS,
-            "lcg": {"a": sway_module.LCG_A, "c": sway_module.LCG_C},
-            "period": sway.period,
-            "amplitude": sway.amplitude,
+            "poseRows": pose_module.POSE_ROWS,
+            "lcg": {"a": pose_module.LCG_A, "c": pose_module.LCG_C},
             "roundCone": [int(x) for x in slot_uses_round_cone(rig.slots)],
         },
         "lcg": lcg,
-        "instances": instances,
+        "instances": [{"seed": seed, "yaw": pose_module.instance_yaw(seed)} for seed in SEEDS],
         "cases": cases,
         "frameCount": sum(len(c["frames"]) for c in cases),
     }
 
 
 def test_python_reference_is_sane() -> None:
-    """The reference itself: the sway moves every jointed slot, keeps unit quaternions, and repeats."""
+    """The reference itself: the hopper moves, squashes (so the root rows carry s != 1) and keeps unit
+    quaternions in its rows."""
     reference = python_reference(HOPPER)
     frames = reference["cases"][0]["frames"]
-    quats = np.array([f["quats"] for f in frames[:241]]).reshape(241, -1, 4)
-    assert np.allclose(np.linalg.norm(quats, axis=2), 1.0, atol=1e-14)
-    assert frames[0]["quats"] == frames[120]["quats"] == frames[240]["quats"], "the period is 120 ticks"
-    assert np.ptp(quats, axis=0).max() > 0.05, "the sway does not move"
-    assert frames[241]["tick"] == -1
-    assert frames[241]["quats"] == frames[119]["quats"]
+    squash = [f["root"][5] for f in frames]
+    assert min(squash) < 0.99 < 1.01 < max(squash), "the hopper never squashes in 240 ticks"
+    rows = np.array([f["rowBits"] for f in frames], dtype=np.uint32).view(np.float32)
+    quats = rows[:, : reference["slotCount"] * 20].reshape(len(frames), -1, 20)[:, :, 12:16]
+    assert np.allclose(np.linalg.norm(quats, axis=2), 1.0, atol=1e-6)
+    assert np.ptp(quats, axis=0).max() > 0.05, "the pose does not move"
 
 
 def test_js_core_matches_python(hopper: Path, tmp_path: Path) -> None:

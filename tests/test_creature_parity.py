@@ -1,6 +1,7 @@
 """Creature parity through Playwright: every buildable example package on WebGPU (SwiftShader) against the
-numpy reference, with every gate of creaturegen.lab.creature_parity; plus proofs that the job catches a
-wrong GPU field formula and a shadow pass that does not use the deformed position. Fails (never skips)
+numpy and locomotion references, with every gate of creaturegen.lab.creature_parity; plus proofs that the
+job catches a wrong GPU field formula, a shadow pass that does not use the deformed position, a pre-pass
+that skips the correction and a population that uploads a stale pose. Fails (never skips)
 when the browser or node_modules is missing.
 
 The beetle is left out: its surface fails the euler gate at the hero tier (see test_surface_build.py).
@@ -46,6 +47,8 @@ def test_every_example_passes_every_parity_gate(name: str, out_root: Path) -> No
         "silhouette vs shadow footprint",
         "drawn vertices (deform storage) vs the GPU body path",
         "pipelines created by 50 spawns after reveal",
+        "pose rows (slots and root): GPU vs the Python locomotion reference",
+        "planted feet in the GPU pose buffer vs their plant points",
     ):
         assert expected in names
     assert written["measurements"]["field"]["points"] >= 4096
@@ -123,3 +126,25 @@ def test_the_job_catches_a_deform_pre_pass_that_skips_the_correction(out_root: P
     report = run_creature_parity(planted, groups=("skin",))
     failed = {g["name"] for g in report.gates if g["status"] == "fail"}
     assert failed == {"drawn vertices (deform storage) vs the GPU body path"}, report.summary()
+
+
+@pytest.mark.browser
+def test_the_job_catches_a_population_that_uploads_a_stale_pose(out_root: Path, tmp_path: Path) -> None:
+    """Slots of the previous step under the current root: the feet slide by one step of body motion,
+    which the foot-drift markers measure on the GPU pose buffer (and the pose-row gate sees too)."""
+    package = build("reference/biped.json", out_root)
+    planted = _planted(
+        package,
+        tmp_path,
+        "population.js",
+        [
+            (
+                "writeInstance(page, j, m.quats, m.trans, m.root);",
+                "writeInstance(page, j, m.prevQuats, m.prevTrans, m.root);",
+            )
+        ],
+    )
+    report = run_creature_parity(planted, groups=("field", "motion"))
+    failed = {g["name"] for g in report.gates if g["status"] == "fail"}
+    assert "planted feet in the GPU pose buffer vs their plant points" in failed, report.summary()
+    assert "motion state in the lab vs Python at tick 37 (relative)" not in failed, report.summary()

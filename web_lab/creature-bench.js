@@ -85,10 +85,9 @@ async function main() {
   camera.position.set(0.55 * reach, 0.6 * reach, 0.75 * reach);
   camera.lookAt(0, 0.3 * L, 0);
 
-  const pop = await tsl.createCreaturePopulation(renderer, { capacity, pageSize });
+  // Water for every package (only a swimmer reads it); bodies walk on the default flat ground.
+  const pop = await tsl.createCreaturePopulation(renderer, { capacity, pageSize, water: pkg.createAnalyticWater() });
   scene.add(pop.object3d);
-  const restMinY = Math.min(...data.slots.map((r) => Math.min(r[1] - r[3], r[5] - r[7])));
-  const lift = -restMinY;
   const layout = pop.layout;
   const step = fdStep * L;
 
@@ -112,7 +111,7 @@ async function main() {
     const ids = [];
     const batchStart = performance.now();
     for (let i = 0; i < count; i++) {
-      const position = [((i % gridSide) - (gridSide - 1) / 2) * spacing * L, lift, (Math.floor(i / gridSide) - (gridSide - 1) / 2) * spacing * L];
+      const position = [((i % gridSide) - (gridSide - 1) / 2) * spacing * L, 0, (Math.floor(i / gridSide) - (gridSide - 1) / 2) * spacing * L];
       const start = performance.now();
       ids.push(pop.spawn({ seed: (seed + i) >>> 0, position }));
       spawnTimes.push(performance.now() - start);

@@ -1,6 +1,7 @@
 // Creature lab page: loads a built creature package from /out/<slug>/ and exposes window.__lab for the
-// Playwright harness. Paused and deterministic by default: the pose moves only through seekTick/stepTicks.
-// Every GPU number it reports is read back from the device (buffers or render targets).
+// Playwright harness. Paused and deterministic by default: the pose moves only through seekTick/stepTicks
+// (the package's locomotion core on flat ground, analytic water for swimmers). Every GPU number it reports
+// is read back from the device (buffers or render targets). The cameras and the sun follow body 0.
 import * as THREE from 'three/webgpu';
 import { countDeviceCalls, countDraws, fromBase64, toBase64 } from './lab-common.js';
 
@@ -39,6 +40,8 @@ async function main() {
   scene.background = new THREE.Color(0x1d2430);
   const ground = new THREE.Mesh(new THREE.PlaneGeometry(40 * L, 40 * L), new THREE.MeshStandardNodeMaterial({ color: 0x9aa3ad, roughness: 0.9 }));
   ground.rotation.x = -Math.PI / 2;
+  // A swimmer swims in the analytic water (surface at y = 0): its ground is a seabed below it.
+  if (data.motion.type === 'swimmer') ground.position.y = -2 * L;
   ground.receiveShadow = true;
   scene.add(ground);
   scene.add(new THREE.HemisphereLight(0xdfe8ff, 0x404040, 1.2));
@@ -55,16 +58,60 @@ async function main() {
   camera.position.set(1.6 * L, 1.1 * L, 2.2 * L);
   camera.lookAt(0, 0.3 * L, 0);
 
-  const pop = await pkg.createCreaturePopulation(renderer, { capacity, pageSize });
+  // Water is passed to every package (only a swimmer reads it); the ground plane is the flat support y = 0.
+  const pop = await pkg.createCreaturePopulation(renderer, { capacity, pageSize, water: pkg.createAnalyticWater() });
   scene.add(pop.object3d);
   const diag = pkg.createDiagnostics(renderer, pop);
-  // Lift the body so its lowest posed point rests on the ground.
-  const restMinY = Math.min(...data.slots.map((r) => Math.min(r[1] - r[3], r[5] - r[7])));
-  const lift = -restMinY;
-  pop.spawn({ seed: Number(params.get('seed') ?? 1), position: [0, lift, 0] });
+  pop.spawn({ seed: Number(params.get('seed') ?? 1), position: [0, 0, 0] });
   pop.flush();
 
-  function render() { renderer.render(scene, camera); }
+  // Foot-drift markers: one small sphere per leg of body 0 at its plant point (hidden while in swing),
+  // green when the foot the GPU pose buffer draws sits on it, red otherwise (footDrift() colours them).
+  const legs = data.motion.legs;
+  const feet = new Float64Array(4 * Math.max(1, legs.length));
+  const markerMaterial = new THREE.MeshBasicNodeMaterial();
+  const markers = new THREE.InstancedMesh(new THREE.SphereGeometry(0.025 * L, 8, 6), markerMaterial, Math.max(1, legs.length));
+  markers.count = legs.length;
+  markers.castShadow = false;
+  markers.name = 'foot-drift markers';
+  const markerColour = new THREE.Color();
+  for (let i = 0; i < legs.length; i++) markers.setColorAt(i, markerColour.set(0x30d050));
+  scene.add(markers);
+  const markerMatrix = new THREE.Matrix4();
+  function placeMarkers() {
+    const motion = pop.motion(0);
+    if (!motion || !legs.length) { markers.visible = false; return; }
+    markers.visible = true;
+    motion.feet(feet);
+    for (let i = 0; i < legs.length; i++) {
+      const scale = feet[4 * i + 3] ? 1 : 0;
+      markerMatrix.makeScale(scale, scale, scale).setPosition(feet[4 * i], feet[4 * i + 1], feet[4 * i + 2]);
+      markers.setMatrixAt(i, markerMatrix);
+    }
+    markers.instanceMatrix.needsUpdate = true;
+    markers.computeBoundingSphere();
+  }
+
+  // Frame body 0: the camera keeps its offset and the sun stays straight above; the shadow camera covers
+  // the body's posed bounds with a margin, so thin parts (a tail on the ground) span several texels.
+  const cameraOffset = new THREE.Vector3(1.6 * L, 0.8 * L, 2.2 * L);
+  const focus = new THREE.Vector3();
+  function follow() {
+    const info = pop.instance(0);
+    if (!info.alive) return;
+    const b = info.bounds;
+    focus.set((b[0] + b[3]) / 2, (b[1] + b[4]) / 2, (b[2] + b[5]) / 2);
+    camera.position.copy(focus).add(cameraOffset);
+    camera.lookAt(focus);
+    sun.position.set(focus.x, focus.y + 4 * L, focus.z);
+    sun.target.position.set(focus.x, 0, focus.z);
+    sun.target.updateMatrixWorld();
+    const reach = 0.6 * Math.max(b[3] - b[0], b[5] - b[2], 0.5 * L);
+    Object.assign(sun.shadow.camera, { left: -reach, right: reach, top: reach, bottom: -reach, near: 0.1 * L, far: focus.y + 8 * L });
+    sun.shadow.camera.updateProjectionMatrix();
+  }
+
+  function render() { follow(); placeMarkers(); renderer.render(scene, camera); }
 
   const t0 = performance.now();
   await pop.warm(scene, camera);
@@ -101,6 +148,9 @@ async function main() {
   //     the dark footprint on the ground is the shadow map's coverage of the same position function.
   const silhouetteMaterial = new THREE.MeshBasicNodeMaterial({ color: 0xffffff });
   async function shadowParity(size = 128) {
+    follow();
+    const markersVisible = markers.visible;
+    markers.visible = false;
     const cam = sun.shadow.camera.clone();
     cam.position.copy(sun.position);
     cam.lookAt(sun.target.position);
@@ -123,8 +173,13 @@ async function main() {
     materials.forEach((m, i) => { m.emissiveNode = savedEmissive[i]; m.colorNode = savedColour[i]; m.needsUpdate = true; });
     sun.intensity = lightsVisible[0];
     hemi.intensity = hemiIntensity;
-    // (2) footprint: ground only for the camera, body only in the shadow pass (layer 1).
+    // (2) footprint: ground only for the camera, body only in the shadow pass (layer 1). The receiver is
+    // lowered by 0.1 L for this pass: where the body rests on the support (feet, a tail on the ground) a
+    // shadow map cannot resolve the contact, and the straight-down projection is the same at any depth.
     ground.visible = true;
+    const groundY = ground.position.y;
+    ground.position.y = groundY - 0.1 * L;
+    ground.updateMatrixWorld();
     scene.background = savedBackground;
     for (const p of pop.pages) p.mesh.layers.set(1);
     sun.shadow.camera.layers.enable(1);
@@ -133,6 +188,9 @@ async function main() {
     hemi.intensity = hemiIntensity;
     for (const p of pop.pages) p.mesh.layers.set(0);
     sun.shadow.camera.layers.disable(1);
+    ground.position.y = groundY;
+    ground.updateMatrixWorld();
+    markers.visible = markersVisible;
     return { size, silhouette: toBase64(silhouette), footprint: toBase64(lit) };
   }
 
@@ -155,7 +213,7 @@ async function main() {
     }
     if (view === 'top') {
       const cam = sun.shadow.camera.clone();
-      cam.position.copy(sun.position); cam.lookAt(0, 0, 0); cam.updateMatrixWorld();
+      cam.position.copy(sun.position); cam.lookAt(sun.target.position); cam.updateMatrixWorld();
       return { view, width: 128, height: 128, rgba: toBase64(await renderTo(cam, 128, 128)) };
     }
     throw new Error(`capturePixels: view is front, portrait or top (got ${view})`);
@@ -177,12 +235,15 @@ async function main() {
         features: [...device.features].sort(),
         tier: data.tier, slots: data.slotCount, registers: data.registers, programs: data.programCount,
         vertices: data.mesh.vertices, triangles: data.mesh.triangles, capacity, pageSize: pop.pageSize, pages: pop.pages.length,
-        signatures: data.signatures, bodyScale: L, canvas: [width, height], lift,
+        signatures: data.signatures, bodyScale: L, canvas: [width, height], locomotion: data.motion.type, tickRate: data.tickRate,
       };
     },
     async load(next) { location.search = `?pkg=${encodeURIComponent(next)}`; },
     seekTick(n) { const bytes = pop.seekTick(n); render(); return bytes; },
-    stepTicks(n = 1) { let bytes = 0; for (let k = 0; k < n; k++) bytes += pop.stepTicks(1); render(); return bytes; },
+    /** n fixed steps of every body, one upload and one deform pre-pass of the result, one frame. */
+    stepTicks(n = 1) { const bytes = pop.stepTicks(n); render(); return bytes; },
+    /** One render frame of dt seconds through the population's fixed-step driver (interpolated pose). */
+    update(dt) { const steps = pop.update(dt); render(); return { steps, alpha: pop.driver.alpha }; },
     stateHash() { return pop.stateHash(); },
     telemetry() {
       return {
@@ -198,13 +259,13 @@ async function main() {
       const ids = [];
       const side = Math.ceil(Math.sqrt(count));
       for (let i = 0; i < count; i++) {
-        const position = [((i % side) - (side - 1) / 2) * spacing * L, lift, (Math.floor(i / side) - (side - 1) / 2) * spacing * L];
+        const position = [((i % side) - (side - 1) / 2) * spacing * L, 0, (Math.floor(i / side) - (side - 1) / 2) * spacing * L];
         const start = performance.now();
         ids.push(pop.spawn({ seed: (seed + i) >>> 0, position }));
         spawnTimes.push(performance.now() - start);
       }
-      pop.flush();
-      if (draw) render();
+      // Without drawing, the new bodies stay dirty until the next flush (the next tick's one upload).
+      if (draw) { pop.flush(); render(); }
       return ids;
     },
     despawnAll(keep = []) {
@@ -217,6 +278,40 @@ async function main() {
       return Array.from(r);
     },
     async readPose(i = 0) { return Array.from(await diag.readPose(i)); },
+    /** The locomotion gates of body i (worst values since its reset, measured by the JS core every tick). */
+    motionGates(i = 0) { return pop.motion(i).gates; },
+    /** Body i's locomotion state as the JS core in this page holds it (root, slots, ropes) and its tick. */
+    motionState(i = 0) { const m = pop.motion(i); return { tick: m.tick, state: m.stateVector() }; },
+    /**
+     * Foot drift measured on the GPU pose buffer: for each planted leg of body i, its foot as the GPU rows
+     * place it (lower slot's quaternion and translation read back, then the root rows: squash, yaw,
+     * position) against the plant point of the JS core in world space, over the leg length. Colours the
+     * markers: green within `tolerance` leg lengths, red beyond.
+     */
+    async footDrift(i = 0, tolerance = 1e-5) {
+      const rows = await diag.readPose(i);
+      const motion = pop.motion(i);
+      motion.feet(feet);
+      const r = data.slotCount * data.poseRows * 4;
+      const root = [rows[r], rows[r + 1], rows[r + 2], rows[r + 4], rows[r + 5], rows[r + 6]];
+      const k = 1 / Math.sqrt(root[5]);
+      const out = [];
+      for (let l = 0; l < legs.length; l++) {
+        const leg = legs[l];
+        const o = leg.lower * data.poseRows * 4;
+        const q = new Float64Array([rows[o + 12], rows[o + 13], rows[o + 14], rows[o + 15]]);
+        const p = new Float64Array(3);
+        pkg.rotate(q, 0, leg.foot, 0, p, 0);
+        const x = (p[0] + rows[o + 16]) * k, y = (p[1] + rows[o + 17]) * root[5], z = (p[2] + rows[o + 18]) * k;
+        const world = [root[3] * x + root[4] * z + root[0], y + root[1], -root[4] * x + root[3] * z + root[2]];
+        const planted = feet[4 * l + 3] === 1;
+        const drift = Math.hypot(world[0] - feet[4 * l], world[1] - feet[4 * l + 1], world[2] - feet[4 * l + 2]) / (leg.a + leg.b);
+        if (planted) markers.setColorAt(l, markerColour.set(drift <= tolerance ? 0x30d050 : 0xe03030));
+        out.push({ leg: leg.part, planted, drift });
+      }
+      if (markers.instanceColor) markers.instanceColor.needsUpdate = true;
+      return out;
+    },
     stagedPose(i = 0) { return Array.from(pop.stagedPose(i)); },
     async readSkinned(i = 0) {
       const r = await diag.readSkinned(i);
@@ -266,7 +361,8 @@ function wireControls(lab, modes) {
   document.getElementById('step').onclick = () => lab.stepTicks(1);
   document.getElementById('grid').onclick = () => lab.spawn(100, 63);
   let playing = false;
-  const loop = () => { if (!playing) return; lab.stepTicks(1); requestAnimationFrame(loop); };
+  // Play at a fixed 1/60 s per animation frame: deterministic whatever the display rate.
+  const loop = () => { if (!playing) return; lab.update(1 / 60); requestAnimationFrame(loop); };
   document.getElementById('play').onclick = () => { playing = !playing; if (playing) requestAnimationFrame(loop); };
 }
 

@@ -155,7 +155,7 @@ def _build_creature(args: argparse.Namespace, spec: CharacterSpec, data: bytes) 
     _print_gates(build)
     counts = build.sidecar["counts"]
     print(f"  mesh {counts}; " + ("cache hit" if build.cached else "extracted"))
-    print("==> package: candidate program tapes, sway pose, templates")
+    print("==> package: candidate program tapes, locomotion data, templates")
     picture = args.picture == "on"
     if args.picture == "auto":
         reason = picture_unavailable()

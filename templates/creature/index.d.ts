@@ -1,4 +1,7 @@
 import type { Camera, Group, Mesh, Object3D, WebGPURenderer } from 'three/webgpu';
+import type { Driver, GravityProvider, Motion, SupportSurfaceProvider, WaterSurfaceProvider } from './core/index.js';
+
+export * from './core/index.js';
 
 export type DebugMode = 'off' | 'skin-only' | 'distance' | 'weights' | 'normals' | 'candidates' | 'shell';
 export type TierName = 'hero' | 'repeated' | 'distant';
@@ -14,20 +17,30 @@ export interface PopulationOptions {
   debugMode?: DebugMode;
   /** Where to fetch assets/surface.glb from (default: next to this module). */
   surfaceUrl?: string;
+  /** The ground every body walks on (default: flat ground at y = 0; see builtinSupports()). */
+  support?: SupportSurfaceProvider;
+  /** Gravity, never scaled by creature scale (default: 9.80665 m/s² down). */
+  gravity?: GravityProvider;
+  /** Required for a swimmer (refused with TierRefusedError without one, or with a missing channel). */
+  water?: WaterSurfaceProvider;
 }
 
 export interface SpawnOptions {
-  /** Unsigned 32-bit seed: the sway phase offset and yaw come from the package's LCG. */
+  /** Unsigned 32-bit seed: the heading comes from the package's LCG. */
   seed?: number;
+  /** Where the body's path starts; the locomotion puts it on the support, the water or at its altitude. */
   position?: [number, number, number];
 }
 
 export interface InstanceInfo {
   alive: boolean;
   seed: number;
-  tickOffset: number;
-  yaw: number;
-  position: [number, number, number];
+  /** Population tick at spawn: the body's own tick is the population's minus this. */
+  spawnTick: number;
+  /** The body's own tick (null when dead). */
+  tick: number | null;
+  /** x, y, z, cos yaw, sin yaw, squash (null when dead). */
+  root: number[] | null;
   /** Posed world AABB: min xyz, max xyz. */
   bounds: number[];
 }
@@ -52,10 +65,19 @@ export interface CreaturePopulation {
   /** Validation plus an O(slots) write; returns the instance id. Throws when full. */
   spawn(options?: SpawnOptions): number;
   despawn(id: number): void;
-  /** Advance n fixed ticks; returns the bytes uploaded. */
+  readonly support: SupportSurfaceProvider;
+  readonly gravity: GravityProvider;
+  readonly water: WaterSurfaceProvider | null;
+  /** The fixed-step driver update() uses. */
+  readonly driver: Driver;
+  /** Advance every body n fixed ticks (pose of the current step); returns the bytes uploaded. */
   stepTicks(n?: number): number;
-  /** Jump to tick n; returns the bytes uploaded. */
+  /** Every body re-simulated to tick n (same state as stepping there); returns the bytes uploaded. */
   seekTick(n: number): number;
+  /** One render frame of dt seconds: the fixed steps due, then the interpolated render pose; returns steps. */
+  update(dt: number): number;
+  /** The locomotion core of a live instance, or null. */
+  motion(id: number): Motion | null;
   /** Upload the dirty pose ranges left by spawn/despawn and run the deform pre-pass over them. */
   flush(): number;
   instance(id: number): InstanceInfo;
@@ -77,12 +99,7 @@ export interface CreatureDiagnostics {
   readDeformed(id: number): Promise<{ position: Float32Array; gradient: Float32Array; distance: Float32Array; accepted: Float32Array; colour: Float32Array; program: Float32Array }>;
 }
 
-export const CREATURE: Readonly<Record<string, unknown>>;
 export const DEBUG_MODES: readonly DebugMode[];
 /** Requires an initialised WebGPURenderer on a WebGPU backend; throws otherwise. */
 export function createCreaturePopulation(renderer: WebGPURenderer, options?: PopulationOptions): Promise<CreaturePopulation>;
 export function createDiagnostics(renderer: WebGPURenderer, population: CreaturePopulation, options?: { maxPoints?: number }): CreatureDiagnostics;
-export function hashBytes(bytes: Uint8Array | Uint8Array[], tick: number): string;
-export function instanceOffset(seed: number, lcg: { a: number; c: number }, period: number): { tickOffset: number; yaw: number };
-export function lcgNext(state: number, a: number, c: number): number;
-export function parseGlb(buffer: ArrayBuffer): { attributes: Record<string, { array: Float32Array | Uint16Array | Uint32Array; itemSize: number }>; index: { array: Uint16Array | Uint32Array }; extras: Record<string, unknown> };

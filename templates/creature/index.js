@@ -1,2 +1,2 @@
-export { CREATURE, hashBytes, instanceOffset, lcgNext, parseGlb, swayTransforms, writePoseRows } from './core/index.js';
+export * from './core/index.js';
 export { DEBUG_MODES, createCreaturePopulation, createDiagnostics } from './tsl/index.js';

@@ -1,1 +1,1 @@
-"""The creature package: build plan, program tapes, the closed-form sway pose, and the package writer."""
+"""The creature package: build plan, program tapes, pose pages and the seeded LCG, and the package writer."""

@@ -1,7 +1,8 @@
 """The creature build plan: every number the package's runtime needs, computed once, as plain JSON data.
 
 Templates print this plan and nothing else. ``plan["runtime"]`` becomes core/data.js; the Python
-reference (creature/sway.py, creature/reference.py) reads the same rig, skeleton and tapes, which is what
+reference (motion/simulate.py, creature/pose.py, creature/reference.py) reads the same rig, skeleton and
+tapes, which is what
 makes the lab-vs-numpy parity job meaningful.
 """
 
@@ -23,7 +24,7 @@ from ..surface import correct as correction
 from ..surface.build import NO_PROGRAM, SurfaceBuild
 from ..surface.deform import METHODS
 from ..surface.skeleton import Skeleton, build_skeleton
-from . import sway as sway_module
+from .pose import LCG_A, LCG_C, POSE_ROWS
 from .tape import Tape, compile_tape
 
 #: The runtime's debug views (lab `setDebugMode`); "shell" is the diagnostic capsule shell.
@@ -37,7 +38,6 @@ class CreaturePlan:
     plan: dict[str, Any]
     tapes: tuple[Tape, ...]  # candidate programs in asset order, then the full graph
     skeleton: Skeleton
-    sway: sway_module.Sway
 
 
 def program_tapes(spec: CharacterSpec, rig: CompiledRig, tier: str) -> tuple[list[Tape], str]:
@@ -69,7 +69,6 @@ def build_plan(
     spec: CharacterSpec, rig: CompiledRig, surface: SurfaceBuild, spec_sha256: str
 ) -> CreaturePlan:
     skeleton = build_skeleton(spec, rig)
-    sway = sway_module.build_sway(rig, skeleton)
     motion = build_motion(spec, rig, skeleton)
     tapes, note = program_tapes(spec, rig, surface.tier)
     floors = floors_for(rig.body_scale)
@@ -84,22 +83,13 @@ def build_plan(
         "tier": surface.tier,
         "bodyScale": rig.body_scale,
         "slotCount": rig.slot_count,
-        # One extra "part" per instance: the root transform rows (position + alive, yaw cos/sin).
+        # One extra "part" per instance: the root rows (position + alive, yaw cos/sin + squash).
         "maxParts": rig.slot_count + 1,
-        "poseRows": sway_module.POSE_ROWS,
+        "poseRows": POSE_ROWS,
         "slots": rig.slots.tolist(),
         "slotNames": list(skeleton.names),
         "roundCone": [int(x) for x in slot_uses_round_cone(rig.slots)],
-        "sway": {
-            "parent": list(sway.parent),
-            "order": list(sway.order),
-            "pivot": sway.pivot.tolist(),
-            "axis": sway.axis.tolist(),
-            "phase": sway.phase.tolist(),
-            "amplitude": sway.amplitude,
-            "period": sway.period,
-        },
-        "lcg": {"a": sway_module.LCG_A, "c": sway_module.LCG_C},
+        "lcg": {"a": LCG_A, "c": LCG_C},
         "motion": motion,
         "tickRate": motion["hz"],
         "programData": program_data(tapes),
@@ -138,10 +128,10 @@ def build_plan(
             "vertices": asset.vertex_count,
             "triangles": runtime["mesh"]["triangles"],
             "correctedVertices": corrected,
-            "poseBytesPerBody": runtime["maxParts"] * sway_module.POSE_ROWS * 16,
+            "poseBytesPerBody": runtime["maxParts"] * POSE_ROWS * 16,
             # The deform pre-pass storage (tsl/deform.js DEFORM_STRIDE vec4 per vertex).
             "deformBytesPerBody": asset.vertex_count * DEFORM_STRIDE * 16,
         },
         "methods": {m: int(np.count_nonzero(skin[:, 0] == i)) for i, m in enumerate(METHODS)},
     }
-    return CreaturePlan(plan, tuple(tapes), skeleton, sway)
+    return CreaturePlan(plan, tuple(tapes), skeleton)

@@ -1,6 +1,6 @@
 """The Python side of the creature parity job: what the lab's GPU readbacks are compared against.
 
-Everything here is the numpy float64 reference (field/sampler.py, surface/deform.py, creature/sway.py),
+Everything here is the float64 reference (field/sampler.py, surface/deform.py, motion/simulate.py),
 rebuilt from the package's own ``assets/spec.json`` and ``assets/surface.glb``; nothing is read from the
 package's JS or computed by the browser.
 """
@@ -9,6 +9,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 import numpy.typing as npt
@@ -16,13 +17,15 @@ import numpy.typing as npt
 from ..field import layout as col
 from ..field.floors import floors_for
 from ..field.sampler import FieldSample, sample_graph
+from ..motion.providers import AnalyticWater
+from ..motion.rig import build_motion
+from ..motion.simulate import Motion
 from ..rig import CompiledRig, compile_rig
 from ..rig.graph import Ref
 from ..spec import CharacterSpec, validate_bytes
 from ..surface.asset import SurfaceAsset, read_glb
 from ..surface.deform import Pose, skin_cor, skin_dq, skin_lbs
 from ..surface.skeleton import build_skeleton
-from . import sway as sway_module
 
 F64 = npt.NDArray[np.float64]
 
@@ -34,7 +37,7 @@ PROBE_MIX = {"caps": 0.25, "taper": 0.25, "blends": 0.25}
 class PackageReference:
     spec: CharacterSpec
     rig: CompiledRig
-    sway: sway_module.Sway
+    motion: dict[str, Any]  # CREATURE.motion, rebuilt from the spec
     asset: SurfaceAsset
 
 
@@ -44,13 +47,18 @@ def load_reference(package: Path) -> PackageReference:
     if not isinstance(spec, CharacterSpec):
         raise ValueError(f"{package}: assets/spec.json is not a creature spec")
     rig = compile_rig(spec)
-    sway = sway_module.build_sway(rig, build_skeleton(spec, rig))
-    return PackageReference(spec, rig, sway, read_glb(package / "assets" / "surface.glb"))
+    motion = build_motion(spec, rig, build_skeleton(spec, rig))
+    return PackageReference(spec, rig, motion, read_glb(package / "assets" / "surface.glb"))
 
 
-def instance_tick(tick: int, seed: int) -> int:
-    """The sway tick of an instance spawned from ``seed`` when the population is at ``tick``."""
-    return tick + sway_module.instance_offset(seed)[0]
+def instance_motion(
+    ref: PackageReference, seed: int, tick: int, position: tuple[float, float, float]
+) -> Motion:
+    """An instance spawned from ``seed`` at ``position`` on the built-in flat ground (the analytic water
+    for a swimmer: the providers a population uses by default), stepped to its tick ``tick``."""
+    motion = Motion(ref.motion, water=AnalyticWater(), seed=seed, position=position)
+    motion.step_ticks(tick)
+    return motion
 
 
 def field_at(ref: PackageReference, table: F64, points: F64) -> FieldSample:

@@ -2,7 +2,8 @@
 and diff what the GPU computed, read back from the device, against the numpy reference.
 
 Gates, all measured in the run (thresholds are relative to the body scale L where they are lengths):
-- pose pages: the GPU pose rows after seekTick vs the Python sway in float32;
+- pose pages: the GPU pose rows (slots and root) after seekTick vs the Python locomotion reference
+  (motion/simulate.py) in float32;
 - field: GPU probeField (a compute kernel running the material's own TSL field program) vs numpy float64
   at ≥ 4096 seeded points on caps, inside tapers, across blends and over the box: |Δd| and the normal
   angle (points where numpy's own float32 and float64 normals disagree by more than the tolerance sit on a
@@ -13,7 +14,9 @@ Gates, all measured in the run (thresholds are relative to the body scale L wher
 - shadows: the silhouette seen from the sun vs the shadow footprint on the ground (the depth pass uses the
   same position function), max distance of a disagreeing texel to the other mask's edge;
 - no GPU validation errors; no pipelines and no buffers created by 50 spawns after reveal;
-- stateHash(seekTick(n)) == stateHash(stepTicks(n)).
+- stateHash(seekTick(n)) == stateHash(stepTicks(n));
+- motion: the JS locomotion core in the page vs Python (relative 1e-12), and every planted foot as the GPU
+  pose buffer draws it (rows read back, root squash/yaw/position applied) on its plant point.
 """
 
 from __future__ import annotations
@@ -32,7 +35,7 @@ from playwright.sync_api import Page
 from scipy import ndimage
 
 from ..creature import reference as cref
-from ..creature import sway as sway_module
+from ..creature.pose import as_pose, pose_rows, root_rows
 from ..surface.deform import posed_slots
 from .browser import launch_lab_page
 from .png import write_png
@@ -40,9 +43,11 @@ from .report import ParityReport
 from .server import WEB_LAB, serve
 
 DEFAULT_CANVAS = (192, 144)
-#: The pose tick the GPU gates run at (away from rest), and the seed of instance 0 (the lab's default).
+#: The pose tick the GPU gates run at (away from rest: feet in swing, the hopper in the air), and the seed
+#: and spawn position of instance 0 (the lab's defaults).
 PARITY_TICK = 37
 LAB_SEED = 1
+LAB_POSITION = (0.0, 0.0, 0.0)
 PROBE_POINTS = 4096
 #: float32 tolerances relative to L: field distance, skinned position; normal angle in degrees.
 DISTANCE_TOL = 1e-5
@@ -52,6 +57,9 @@ ANGLE_TOL_DEG = 0.05
 NEVER_WORSE_SLACK = 1e-6
 #: Silhouette vs shadow footprint: a disagreeing texel may lie at most this far from the other's edge.
 SHADOW_TEXELS = 2.0
+#: A planted foot drawn from float32 pose rows lies on its float64 plant point to float32 precision
+#: (leg lengths); legged bodies must have at least one planted foot at the parity tick.
+FOOT_DRIFT_TOL = 1e-5
 SPAWNS = 50
 
 F64 = npt.NDArray[np.float64]
@@ -138,15 +146,23 @@ def _hash_gate(page: Page, report: ParityReport) -> None:
 
 def _pose_and_field_gates(page: Page, ref: cref.PackageReference, report: ParityReport) -> None:
     scale = ref.rig.body_scale
-    quats, trans = sway_module.sway_transforms(ref.sway, cref.instance_tick(PARITY_TICK, LAB_SEED))
+    motion = cref.instance_motion(ref, LAB_SEED, PARITY_TICK, LAB_POSITION)
     gpu_rows = np.asarray(page.evaluate("() => window.__lab.readPose(0)"), dtype=np.float32)
-    rows = sway_module.pose_rows(ref.rig, quats, trans).reshape(-1)
+    rows = np.concatenate(
+        [pose_rows(ref.rig, motion.quats, motion.trans).reshape(-1), root_rows(motion.root).reshape(-1)]
+    )
     report.gate(
-        "pose rows: GPU vs Python", float(np.abs(gpu_rows[: rows.size] - rows).max()) / scale, 1e-6, "L"
+        "pose rows (slots and root): GPU vs the Python locomotion reference",
+        float(np.abs(gpu_rows[: rows.size] - rows).max()) / scale,
+        1e-6,
+        "L",
     )
-    table = posed_slots(
-        ref.rig.slots, sway_module.sway_pose(ref.sway, cref.instance_tick(PARITY_TICK, LAB_SEED))
-    )
+    report.measurements["motion"] = {
+        "tick": PARITY_TICK,
+        "root": list(motion.root),
+        "gates": motion.gates.as_dict(),
+    }
+    table = posed_slots(ref.rig.slots, as_pose(motion.quats, motion.trans))
     points = cref.probe_points(table, cref.blend_pairs(ref.rig), PROBE_POINTS)
     raw = page.evaluate("(p) => window.__lab.probeField(p)", points.reshape(-1).tolist())
     gpu = np.asarray(raw, dtype=np.float64).reshape(-1, 4)
@@ -176,9 +192,37 @@ def _pose_and_field_gates(page: Page, ref: cref.PackageReference, report: Parity
     }
 
 
+def _motion_gates(page: Page, ref: cref.PackageReference, report: ParityReport) -> None:
+    """The locomotion core as it runs in the page (V8 in Chromium) against the Python reference, and the
+    planted feet as the GPU pose buffer draws them against their plant points (the lab's markers)."""
+    scale = ref.rig.body_scale
+    motion = cref.instance_motion(ref, LAB_SEED, PARITY_TICK, LAB_POSITION)
+    got = page.evaluate("() => window.__lab.motionState(0)")
+    expected = np.asarray(motion.state_vector())
+    state = np.asarray(got["state"], dtype=np.float64)
+    relative = float(np.abs(state - expected).max() / max(float(np.abs(expected).max()), scale))
+    report.gate(
+        f"motion state in the lab vs Python at tick {PARITY_TICK} (relative)",
+        relative if got["tick"] == PARITY_TICK and state.shape == expected.shape else 1.0,
+        1e-12,
+        "rel",
+    )
+    feet = page.evaluate("() => window.__lab.footDrift(0)")
+    planted = [f["drift"] for f in feet if f["planted"]]
+    report.gate(
+        "planted feet in the GPU pose buffer vs their plant points",
+        max(planted, default=0.0),
+        FOOT_DRIFT_TOL,
+        "leg lengths",
+        passed=(bool(planted) or not feet) and max(planted, default=0.0) <= FOOT_DRIFT_TOL,
+    )
+    report.measurements["feet"] = {"legs": len(feet), "planted": len(planted), "drift": feet}
+
+
 def _skin_gates(page: Page, ref: cref.PackageReference, report: ParityReport) -> None:
     scale = ref.rig.body_scale
-    pose = sway_module.sway_pose(ref.sway, cref.instance_tick(PARITY_TICK, LAB_SEED))
+    motion = cref.instance_motion(ref, LAB_SEED, PARITY_TICK, LAB_POSITION)
+    pose = as_pose(motion.quats, motion.trans)
     table = posed_slots(ref.rig.slots, pose)
     got = page.evaluate("() => window.__lab.readSkinned(0)")
     skinned = _b64_floats(got["skinned"]).reshape(-1, 3).astype(np.float64)
@@ -275,7 +319,7 @@ def _pictures(page: Page, package: Path, debug: bool) -> None:
     page.evaluate("() => window.__lab.setDebugMode('off')")
 
 
-GATE_GROUPS = ("population", "hash", "field", "skin", "shadow")
+GATE_GROUPS = ("population", "hash", "field", "motion", "skin", "shadow")
 
 
 def run_creature_parity(
@@ -307,6 +351,7 @@ def run_creature_parity(
         phase("hash", lambda: _hash_gate(page, report))
         page.evaluate(f"() => window.__lab.seekTick({PARITY_TICK})")
         phase("field", lambda: _pose_and_field_gates(page, ref, report))
+        phase("motion", lambda: _motion_gates(page, ref, report))
         phase("skin", lambda: _skin_gates(page, ref, report))
         phase("shadow", lambda: _shadow_gate(page, package, report))
         t = time.perf_counter()

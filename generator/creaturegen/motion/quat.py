@@ -58,6 +58,16 @@ def length(a: Vec) -> float:
     return math.sqrt(a[0] * a[0] + a[1] * a[1] + a[2] * a[2])
 
 
+def norm3(x: float, y: float, z: float) -> float:
+    """|(x, y, z)| as sqrt((x² + y²) + z²): the JS core's norm3 (math.hypot and Math.hypot round differently,
+    and Math.hypot is a builtin call that boxes its arguments)."""
+    return math.sqrt(x * x + y * y + z * z)
+
+
+def distance(a: Vec, b: Vec) -> float:
+    return norm3(a[0] - b[0], a[1] - b[1], a[2] - b[2])
+
+
 def normalize(a: Vec) -> Vec:
     n = length(a)
     return [a[0] / n, a[1] / n, a[2] / n]

@@ -15,6 +15,7 @@ from ..field import layout as col
 from ..rig import CompiledRig
 from ..spec import CharacterSpec
 from ..surface.skeleton import Skeleton
+from . import quat as vq
 
 #: Walkers, hoppers and swimmers circle at this many body lengths (flyers use their spec radius).
 PATH_RADIUS_BODIES: Final = 6.0
@@ -41,6 +42,10 @@ SWIM_RESPONSE: Final = 1.0
 ROPE_SUBSTEPS: Final = 2
 ROPE_PASSES: Final = 4
 ROPE_DAMPING: Final = 0.02
+#: Largest bend between consecutive rope segments (and between the first segment and its rest direction
+#: on the body), degrees: a tail bends, it does not fold back on itself. Enforced in every relaxation pass
+#: as a minimum distance 2·segment·cos(limit/2) between a node's neighbours.
+ROPE_BEND_LIMIT_DEG: Final = 60.0
 
 WALKERS: Final = ("biped", "quadruped", "hexapod")
 
@@ -77,6 +82,9 @@ def build_motion(spec: CharacterSpec, rig: CompiledRig, skeleton: Skeleton) -> d
         norm = math.sqrt(sum(c * c for c in hint)) or 1.0
         a = math.dist(hip, knee)
         b = math.dist(knee, foot)
+        unit_hint = [c / norm for c in hint]
+        reach = vq.normalize([foot[i] - hip[i] for i in range(3)])
+        hinge = vq.normalize(vq.cross(reach, vq.gram_schmidt(unit_hint, reach)))
         legs.append(
             {
                 "part": part.id,
@@ -87,7 +95,10 @@ def build_motion(spec: CharacterSpec, rig: CompiledRig, skeleton: Skeleton) -> d
                 "foot": foot,
                 "a": a,
                 "b": b,
-                "hint": [c / norm for c in hint],
+                "hint": unit_hint,
+                # The knee's rest hinge axis (normal of the hip-knee-foot plane): the slot frames' second
+                # axis, so the bones never twist as the leg swings (see motion/ik.py).
+                "hinge": hinge,
                 "group": phases.index(float(part.phase or 0.0)),
                 "reachMin": abs(a - b) + REACH_MARGIN * (a + b),
                 "reachMax": (a + b) * (1.0 - REACH_MARGIN),
@@ -99,13 +110,19 @@ def build_motion(spec: CharacterSpec, rig: CompiledRig, skeleton: Skeleton) -> d
             continue
         chain = by_part[part.id]
         rest = [_v(slots[s, col.A]) for s in chain] + [_v(slots[chain[-1], col.B])]
+        radius = [float(slots[s, col.RA]) for s in chain] + [float(slots[chain[-1], col.RB])]
+        segment = math.dist(rest[0], rest[1])
         ropes.append(
             {
                 "part": part.id,
                 "slots": chain,
                 "parent": skeleton.parent[chain[0]],
                 "rest": rest,
-                "segment": math.dist(rest[0], rest[1]),
+                # The rest point one segment before the anchor, on the body: the bend limit's first reference.
+                "before": [2.0 * rest[0][i] - rest[1][i] for i in range(3)],
+                "radius": radius,
+                "segment": segment,
+                "bendMin": 2.0 * segment * math.cos(math.radians(ROPE_BEND_LIMIT_DEG) / 2.0),
             }
         )
     wings = []
@@ -174,5 +191,8 @@ def build_motion(spec: CharacterSpec, rig: CompiledRig, skeleton: Skeleton) -> d
             "ropeSubsteps": ROPE_SUBSTEPS,
             "ropePasses": ROPE_PASSES,
             "ropeDamping": ROPE_DAMPING,
+            "ropeBendLimitDeg": ROPE_BEND_LIMIT_DEG,
         },
+        # Rope nodes of creatures that stand on the support stay above it by their radius.
+        "ropeGround": kind in WALKERS or kind == "hopper",
     }

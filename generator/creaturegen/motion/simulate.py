@@ -20,7 +20,7 @@ import struct
 from dataclasses import dataclass, field
 from typing import Any
 
-from ..creature.sway import instance_offset
+from ..creature.pose import instance_yaw
 from . import quat as vq
 from .derived import Derived, derive
 from .ik import solve_leg
@@ -100,8 +100,9 @@ class Motion:
             missing = [c for c in SWIMMER_CHANNELS if c not in water.channels]
             if missing:
                 raise TierRefusedError(f"swimmer: the water provider does not represent {', '.join(missing)}")
-        self.d: Derived = derive(data, self.gravity.at(0.0))
-        _, yaw = instance_offset(seed)
+        self.gravity0 = self.gravity.at(0.0)
+        self.d: Derived = derive(data, self.gravity0)
+        yaw = instance_yaw(seed)
         self.theta0 = -yaw
         self.position = [float(c) for c in position]
         self.slot_count = len(data["parent"])
@@ -244,7 +245,7 @@ class Motion:
         if self.data["legs"]:
             self._gait(n, frame, integrate)
         if self.data["ropes"]:
-            self._ropes(integrate)
+            self._ropes(frame, integrate)
 
     def _swim(self, n: int, integrate: bool) -> None:
         d, data = self.d, self.data
@@ -373,25 +374,48 @@ class Motion:
             gates.ik_residual = max(gates.ik_residual, ik.residual)
             drawn = vq.rotate(ik.q_lower, leg["foot"])
             drawn = [drawn[0] + ik.t_lower[0], drawn[1] + ik.t_lower[1], drawn[2] + ik.t_lower[2]]
-            gates.drawn_foot = max(gates.drawn_foot, math.dist(drawn, ik.foot) / span)
+            gates.drawn_foot = max(gates.drawn_foot, vq.distance(drawn, ik.foot) / span)
             if ik.clamped:
                 gates.clamped_ticks += 1
             elif foot.planted:
                 back = to_local(frame, self.to_world_root(self.root, drawn))
-                gates.plant_drift = max(gates.plant_drift, math.dist(back, foot.p) / span)
+                gates.plant_drift = max(gates.plant_drift, vq.distance(back, foot.p) / span)
                 gates.planted_samples += 1
         if len(self.feet) == 2 and swinging == 2:
             gates.both_swing_ticks += 1
 
     # --- ropes -----------------------------------------------------------------------------------
 
-    def _anchor_point(self, rope: dict[str, Any], j: int) -> Vec:
-        """Rest point ``j`` of the rope moved rigidly with its parent slot (creature-local)."""
-        q, t = self.quats[rope["parent"]], self.trans[rope["parent"]]
-        r = vq.rotate(q, rope["rest"][j])
+    def _body_point(self, slot: int, x: Vec) -> Vec:
+        """Rest point ``x`` moved rigidly with ``slot`` (creature-local)."""
+        q, t = self.quats[slot], self.trans[slot]
+        r = vq.rotate(q, x)
         return [r[0] + t[0], r[1] + t[1], r[2] + t[2]]
 
-    def _ropes(self, integrate: bool) -> None:
+    def _anchor_point(self, rope: dict[str, Any], j: int) -> Vec:
+        """Rest point ``j`` of the rope moved rigidly with its parent slot (creature-local)."""
+        return self._body_point(rope["parent"], rope["rest"][j])
+
+    @staticmethod
+    def _bend(cur: list[Vec], before: Vec, bend_min: float) -> None:
+        """The bend limit: node j's neighbours at least ``bend_min`` apart (the anchor and the point before
+        it on the body are fixed, so the first two constraints move only the far node)."""
+        for j in range(len(cur) - 1):
+            a = before if j == 0 else cur[j - 1]
+            b = cur[j + 1]
+            dx, dy, dz = b[0] - a[0], b[1] - a[1], b[2] - a[2]
+            dist = math.sqrt(dx * dx + dy * dy + dz * dz)
+            if dist >= bend_min or dist == 0.0:
+                continue
+            f = (dist - bend_min) / dist
+            if j <= 1:
+                cur[j + 1] = [b[0] - dx * f, b[1] - dy * f, b[2] - dz * f]
+            else:
+                hf = 0.5 * f
+                cur[j - 1] = [a[0] + dx * hf, a[1] + dy * hf, a[2] + dz * hf]
+                cur[j + 1] = [b[0] - dx * hf, b[1] - dy * hf, b[2] - dz * hf]
+
+    def _ropes(self, frame: Frame, integrate: bool) -> None:
         d, c = self.d, self.data["constants"]
         if not integrate:
             self.nodes, self.prev_nodes = [], []
@@ -402,7 +426,7 @@ class Motion:
                 ]
                 self.nodes.append(world)
                 self.prev_nodes.append([list(x) for x in world])
-        g = self.gravity.at(self.tick * d.dt)
+        g = self.gravity0 if getattr(self.gravity, "constant", False) else self.gravity.at(self.tick * d.dt)
         substeps, passes, keep = c["ropeSubsteps"], c["ropePasses"], 1.0 - c["ropeDamping"]
         h = d.dt / substeps
         gx, gy, gz = g[0] * h * h, g[1] * h * h, g[2] * h * h
@@ -410,7 +434,8 @@ class Motion:
             cur, prev = self.nodes[index], self.prev_nodes[index]
             anchor_local = self._anchor_point(rope, 0)
             anchor = self.to_world_root(self.root, anchor_local)
-            seg = rope["segment"]
+            seg, bend_min, radius = rope["segment"], rope["bendMin"], rope["radius"]
+            before = self.to_world_root(self.root, self._body_point(rope["parent"], rope["before"]))
             if integrate:
                 for _ in range(substeps):
                     cur[0], prev[0] = list(anchor), list(anchor)
@@ -433,6 +458,12 @@ class Motion:
                                 hf = 0.5 * f
                                 cur[j] = [a[0] + dx * hf, a[1] + dy * hf, a[2] + dz * hf]
                                 cur[j + 1] = [b[0] - dx * hf, b[1] - dy * hf, b[2] - dz * hf]
+                        self._bend(cur, before, bend_min)
+                        if self.data["ropeGround"]:
+                            for j in range(1, len(cur)):
+                                u, h, w = to_local(frame, cur[j])
+                                if h < radius[j]:
+                                    cur[j] = to_world(frame, [u, radius[j], w])
             local = [self.to_local_root(self.root, x) for x in cur]
             rest = rope["rest"]
             # Segment frames by parallel transport down the chain (each turns by the bend from the one
@@ -451,7 +482,7 @@ class Motion:
             t0 = self.trans[rope["slots"][0]]
             posed = [r0[0] + t0[0], r0[1] + t0[1], r0[2] + t0[2]]
             body = self.data["bodyScale"]
-            self.gates.rope_anchor = max(self.gates.rope_anchor, math.dist(posed, anchor_local) / body)
+            self.gates.rope_anchor = max(self.gates.rope_anchor, vq.distance(posed, anchor_local) / body)
 
     # --- output ----------------------------------------------------------------------------------
 

@@ -1,7 +1,8 @@
-// Pure-JS entry (no three imports): creature data, LCG, the sway pose, the .glb reader, stateHash.
+// Pure-JS entry (no three imports): creature data, LCG, pose rows, the .glb reader, stateHash, and the
+// locomotion core (driver, providers, motion) that poses every body.
 export { CREATURE } from './data.js';
-export { lcgNext, instanceOffset } from './lcg.js';
-export { createPoseScratch, rotate, swayTransforms, writePoseRows } from './pose.js';
+export { lcgNext, instanceYaw } from './lcg.js';
+export { rootBounds, rotate, writePoseRows, writeRootRows } from './pose.js';
 export { hashBytes } from './hash.js';
 export { parseGlb } from './glb.js';
 // Locomotion: the fixed-step driver, providers (gravity, support surfaces, water) and the motion core.

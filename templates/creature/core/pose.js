@@ -1,63 +1,19 @@
-// The closed-form sway pose in float64, the same formulas in the same order as creaturegen's
-// Python reference (creature/sway.py): q_s = q_parent ⊗ axisAngle(axis_s, θ_s),
-// t_s = R(q_parent)(pivot_s − R(axisAngle) pivot_s) + t_parent, θ_s = A sin(2π (n mod P)/P + φ_s).
+// Pose pages: one instance's per-slot transforms (from the locomotion core, core/motion/motion.js) as the
+// float32 rows the GPU reads, the same arithmetic in the same order as creaturegen's Python reference
+// (creature/pose.py pose_rows). A posed point is x' = R(q_s)·x + t_s in creature-local space; the root
+// (position, heading, squash) is applied once, by the material.
 
 import { rotate } from './motion/quat.js';
 
 export { rotate };
 
-/** Scratch space for one creature: per-slot quaternions and translations (float64), allocated once. */
-export function createPoseScratch(slotCount) {
-  return {
-    quats: new Float64Array(slotCount * 4),
-    trans: new Float64Array(slotCount * 3),
-    local: new Float64Array(4),
-    tmp: new Float64Array(3),
-  };
-}
-
-/** Per-slot transforms at integer `tick` into `scratch` (no allocation). */
-export function swayTransforms(data, tick, scratch) {
-  const { parent, order, pivot, axis, phase, amplitude, period } = data.sway;
-  const { quats, trans, local, tmp } = scratch;
-  const n = ((tick % period) + period) % period;
-  const phaseOfTick = 2 * Math.PI * (n / period);
-  for (let k = 0; k < order.length; k++) {
-    const s = order[k];
-    const p = parent[s];
-    if (p < 0) {
-      quats[4 * s] = 0; quats[4 * s + 1] = 0; quats[4 * s + 2] = 0; quats[4 * s + 3] = 1;
-      trans[3 * s] = 0; trans[3 * s + 1] = 0; trans[3 * s + 2] = 0;
-      continue;
-    }
-    const angle = amplitude * Math.sin(phaseOfTick + phase[s]);
-    const half = 0.5 * angle;
-    const sh = Math.sin(half);
-    const ax = axis[s];
-    local[0] = ax[0] * sh; local[1] = ax[1] * sh; local[2] = ax[2] * sh; local[3] = Math.cos(half);
-    const pv = pivot[s];
-    rotate(local, 0, pv[0], pv[1], pv[2], tmp, 0);
-    // q_s = q_p ⊗ local
-    const px = quats[4 * p], py = quats[4 * p + 1], pz = quats[4 * p + 2], pw = quats[4 * p + 3];
-    const bx = local[0], by = local[1], bz = local[2], bw = local[3];
-    quats[4 * s] = pw * bx + px * bw + py * bz - pz * by;
-    quats[4 * s + 1] = pw * by - px * bz + py * bw + pz * bx;
-    quats[4 * s + 2] = pw * bz + px * by - py * bx + pz * bw;
-    quats[4 * s + 3] = pw * bw - px * bx - py * by - pz * bz;
-    rotate(quats, 4 * p, pv[0] - tmp[0], pv[1] - tmp[1], pv[2] - tmp[2], trans, 3 * s);
-    trans[3 * s] += trans[3 * p];
-    trans[3 * s + 1] += trans[3 * p + 1];
-    trans[3 * s + 2] += trans[3 * p + 2];
-  }
-}
-
 /**
- * Write one instance's pose rows (POSE_ROWS vec4 per slot) into `target` at float offset `base`:
- * (a, ra), (b, rb), (k, rgb), quaternion xyzw, (t, roundCone). Returns the creature-local AABB of the
- * posed primitives into `bounds` (min xyz, max xyz).
+ * Write one instance's slot rows (POSE_ROWS vec4 per slot) into `target` at float offset `base`:
+ * (a, ra), (b, rb), (k, rgb), quaternion xyzw, (t, roundCone), from per-slot `quats` (xyzw) and `trans`.
+ * `tmp` is a 3-float scratch. Returns the creature-local AABB of the posed primitives into `bounds`
+ * (min xyz, max xyz). Allocates nothing.
  */
-export function writePoseRows(data, scratch, target, base, bounds) {
-  const { quats, trans, tmp } = scratch;
+export function writePoseRows(data, quats, trans, tmp, target, base, bounds) {
   const slots = data.slots;
   const rows = data.poseRows;
   let minX = Infinity, minY = Infinity, minZ = Infinity, maxX = -Infinity, maxY = -Infinity, maxZ = -Infinity;
@@ -66,7 +22,7 @@ export function writePoseRows(data, scratch, target, base, bounds) {
     const o = base + s * rows * 4;
     for (let end = 0; end < 2; end++) {
       const c = end * 4;
-      rotate(quats, 4 * s, row[c], row[c + 1], row[c + 2], tmp, 0);
+      rotate(quats, 4 * s, row, c, tmp, 0);
       const x = tmp[0] + trans[3 * s], y = tmp[1] + trans[3 * s + 1], z = tmp[2] + trans[3 * s + 2];
       const r = row[c + 3];
       target[o + c] = x; target[o + c + 1] = y; target[o + c + 2] = z; target[o + c + 3] = r;
@@ -84,4 +40,28 @@ export function writePoseRows(data, scratch, target, base, bounds) {
     target[o + 19] = data.roundCone[s];
   }
   bounds[0] = minX; bounds[1] = minY; bounds[2] = minZ; bounds[3] = maxX; bounds[4] = maxY; bounds[5] = maxZ;
+}
+
+/**
+ * Write the two root rows at float offset `at`: (x, y, z, alive), (cos yaw, sin yaw, squash, 0), from a
+ * root (x, y, z, cos, sin, squash) as the locomotion core keeps it.
+ */
+export function writeRootRows(root, alive, target, at) {
+  target[at] = root[0]; target[at + 1] = root[1]; target[at + 2] = root[2]; target[at + 3] = alive;
+  target[at + 4] = root[3]; target[at + 5] = root[4]; target[at + 6] = root[5]; target[at + 7] = 0;
+}
+
+/**
+ * World AABB of an instance from its creature-local AABB `local` and root: squash (1/√s, s, 1/√s) about
+ * the creature origin, then the yaw (conservatively: the rotated box's bounds), then the position.
+ */
+export function rootBounds(local, root, out, at) {
+  const k = 1 / Math.sqrt(root[5]);
+  const c = root[3], s = root[4];
+  const cx = 0.5 * (local[0] + local[3]) * k, cz = 0.5 * (local[2] + local[5]) * k;
+  const hx = 0.5 * (local[3] - local[0]) * k, hz = 0.5 * (local[5] - local[2]) * k;
+  const wx = Math.abs(c) * hx + Math.abs(s) * hz, wz = Math.abs(s) * hx + Math.abs(c) * hz;
+  const px = c * cx + s * cz + root[0], pz = -s * cx + c * cz + root[2];
+  out[at] = px - wx; out[at + 1] = local[1] * root[5] + root[1]; out[at + 2] = pz - wz;
+  out[at + 3] = px + wx; out[at + 4] = local[4] * root[5] + root[1]; out[at + 5] = pz + wz;
 }

@@ -1,8 +1,9 @@
 // The body material of one pose page. The vertex stage only reads: the deformed vertex the page's deform
 // pre-pass stored (deform.js: skinned, corrected, the analytic field gradient and the albedo), then the
-// root transform, applied once here (a plain Mesh with `count` instances: no instanceMatrix, so nothing
-// is applied twice). The normal goes to normalLocal, the local-space slot r185 expects. The shadow pass
-// uses this positionNode too (three's default), so it casts the stored surface that is seen.
+// root transform (squash, yaw, position), applied once here (a plain Mesh with `count` instances: no
+// instanceMatrix, so nothing is applied twice); the normal takes the transform's inverse transpose and goes
+// to normalLocal, the local-space slot r185 expects. The shadow pass uses this positionNode too (three's
+// default), so it casts the stored surface that is seen.
 import * as THREE from 'three/webgpu';
 import {
   Fn, attribute, clamp, float, fract, instanceIndex, int, mix, normalLocal, normalize, select, sin,
@@ -25,6 +26,18 @@ const hashColour = (n) => vec3(fract(sin(n.mul(12.9898)).mul(43758.5453)), fract
 
 /** Yaw about +y by the root row (cos, sin), as the JS core writes it. */
 export const rootRotate = (root1, v) => vec3(root1.x.mul(v.x).add(root1.y.mul(v.z)), v.y, root1.y.negate().mul(v.x).add(root1.x.mul(v.z)));
+
+/** A creature-local point under the root row's squash s (x, z by 1/√s, y by s: volume kept) and yaw. */
+export const rootPoint = (root1, p) => {
+  const k = root1.z.inverseSqrt();
+  return rootRotate(root1, vec3(p.x.mul(k), p.y.mul(root1.z), p.z.mul(k)));
+};
+
+/** A creature-local normal under the same transform: the inverse transpose diag(√s, 1/s, √s), renormalised. */
+export const rootNormal = (root1, n) => {
+  const q = root1.z.sqrt();
+  return rootRotate(root1, normalize(vec3(n.x.mul(q), n.y.div(root1.z), n.z.mul(q))));
+};
 
 /**
  * The display material of a page for one debug mode (a variant; cached by the population). `deform` is
@@ -58,8 +71,8 @@ export function createBodyMaterial(layout, pose, deform, mode) {
       colour = r2.xyz;
     }
     vColour.assign(colour);
-    normalLocal.assign(rootRotate(root1, n));
-    return select(root0.w.greaterThan(0.5), rootRotate(root1, r0.xyz).add(root0.xyz), vec3(0));
+    normalLocal.assign(rootNormal(root1, n));
+    return select(root0.w.greaterThan(0.5), rootPoint(root1, r0.xyz).add(root0.xyz), vec3(0));
   })();
   material.colorNode = vColour;
   return material;

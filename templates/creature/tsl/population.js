@@ -1,14 +1,18 @@
 // A population of one creature: fixed-capacity pose pages (vec4 storage, CPU Float32Array staging),
 // one deform pre-pass, one material and one draw per page, coalesced dirty-range uploads, posed bounds
-// per page, spawn as validation plus an O(slots) write. Nothing is created after warm(): pages, deform
-// storage, materials and pipelines (compute, display, shadow) are built and warmed up front.
+// per page. Every body is driven by its own locomotion core (core/motion/motion.js) on the population's
+// support, gravity and water providers; the pose rows are what that core computed. Nothing GPU-side is
+// created after warm(): pages, deform storage, materials and pipelines (compute, display, shadow) are
+// built and warmed up front; a spawn validates, builds the body's CPU motion state and writes O(slots).
 import * as THREE from 'three/webgpu';
 import { instancedArray } from 'three/tsl';
 import { CREATURE } from '../core/data.js';
 import { parseGlb } from '../core/glb.js';
 import { hashBytes } from '../core/hash.js';
-import { instanceOffset } from '../core/lcg.js';
-import { createPoseScratch, swayTransforms, writePoseRows } from '../core/pose.js';
+import { createDriver } from '../core/motion/driver.js';
+import { TierRefusedError, createMotion } from '../core/motion/motion.js';
+import { SWIMMER_CHANNELS, createFlatGround, createGravity } from '../core/motion/providers.js';
+import { rootBounds, writePoseRows, writeRootRows } from '../core/pose.js';
 import { bodyFunctions, layoutOf } from './body.js';
 import {
   DEFORM_STRIDE, createDeformKernel, deformStorage, deformView, dispatchDeform, vertexRecords,
@@ -61,7 +65,9 @@ async function loadSurface(url) {
 /**
  * Create a population. Options: capacity (bodies, default 64), pageSize (bodies per page and draw,
  * at most what one storage binding of the device holds: DEFORM_STRIDE·16 bytes per vertex per body,
- * default 64), tier (the built tier only), debugMode, surfaceUrl (default: this package's asset).
+ * default 64), tier (the built tier only), debugMode, surfaceUrl (default: this package's asset),
+ * support (a SupportSurfaceProvider, default flat ground at y = 0), gravity (a gravity provider, default
+ * standard gravity), water (a WaterSurfaceProvider: required for a swimmer, which is refused without one).
  */
 export async function createCreaturePopulation(renderer, options = {}) {
   assertWebGPU(renderer);
@@ -71,6 +77,14 @@ export async function createCreaturePopulation(renderer, options = {}) {
   if (!Number.isInteger(capacity) || capacity < 1) throw new Error(`capacity: must be a positive integer (got ${capacity})`);
   if (!Number.isInteger(requestedPageSize) || requestedPageSize < 1) {
     throw new Error(`pageSize: must be a positive integer (got ${requestedPageSize})`);
+  }
+  const support = options.support ?? createFlatGround();
+  const gravity = options.gravity ?? createGravity();
+  const water = options.water ?? null;
+  if (data.motion.type === 'swimmer') {
+    if (!water) throw new TierRefusedError(`${data.slug}: a swimmer needs options.water (a WaterSurfaceProvider, e.g. createAnalyticWater())`);
+    const missing = SWIMMER_CHANNELS.filter((c) => !water.channels.includes(c));
+    if (missing.length) throw new TierRefusedError(`${data.slug}: options.water does not represent ${missing.join(', ')}`);
   }
   const tier = options.tier ?? data.tier;
   if (tier !== data.tier) throw new Error(`tier: this package was built for tier ${data.tier} (got ${tier}); rebuild with --tier ${tier}`);
@@ -111,13 +125,18 @@ export async function createCreaturePopulation(renderer, options = {}) {
     const deform = deformStorage(size, vertices);
     pages.push({
       first, size, pose, mesh, staging: pose.value.array, deform, deformView: deformView(deform), kernels: new Map(), shell: null,
-      alive: new Uint8Array(size), seed: new Uint32Array(size), tickOffset: new Int32Array(size),
-      yaw: new Float64Array(size), position: new Float64Array(3 * size), bounds: new Float64Array(6 * size),
+      alive: new Uint8Array(size), seed: new Uint32Array(size), spawnTick: new Float64Array(size),
+      motions: new Array(size).fill(null), bounds: new Float64Array(6 * size),
       dirtyLo: Infinity, dirtyHi: -1,
     });
   }
-  const scratch = createPoseScratch(data.slotCount);
-  const boxScratch = new Float64Array(6);
+  const rootRow = data.slotCount * data.poseRows * 4;
+  const tmp = new Float64Array(3);
+  const localBox = new Float64Array(6);
+  const renderQuats = new Float64Array(4 * data.slotCount);
+  const renderTrans = new Float64Array(3 * data.slotCount);
+  const renderRoot = new Float64Array(6);
+  const driver = createDriver(data.tickRate);
   const corner = new THREE.Vector3();
   const box = new THREE.Box3();
   let tick = 0;
@@ -156,30 +175,19 @@ export async function createCreaturePopulation(renderer, options = {}) {
   }
   for (const page of pages) showMode(page, mode);
 
-  function writeInstance(page, j) {
+  // One body's rows from per-slot transforms and a root (the motion's current step, or its render pose),
+  // and its world bounds; marks the instance dirty for the next flush.
+  function writeInstance(page, j, quats, trans, root) {
     const base = j * floatsPerInstance;
-    swayTransforms(data, tick + page.tickOffset[j], scratch);
-    writePoseRows(data, scratch, page.staging, base, boxScratch);
-    const root = base + data.slotCount * data.poseRows * 4;
-    const c = Math.cos(page.yaw[j]), s = Math.sin(page.yaw[j]);
-    page.staging[root] = page.position[3 * j];
-    page.staging[root + 1] = page.position[3 * j + 1];
-    page.staging[root + 2] = page.position[3 * j + 2];
-    page.staging[root + 3] = page.alive[j];
-    page.staging[root + 4] = c;
-    page.staging[root + 5] = s;
-    page.staging[root + 6] = 0;
-    page.staging[root + 7] = 0;
-    // Posed AABB of the primitives, rotated by the yaw (conservatively) and moved: the instance bounds.
-    const cx = 0.5 * (boxScratch[0] + boxScratch[3]), cz = 0.5 * (boxScratch[2] + boxScratch[5]);
-    const hx = 0.5 * (boxScratch[3] - boxScratch[0]), hz = 0.5 * (boxScratch[5] - boxScratch[2]);
-    const wx = Math.abs(c) * hx + Math.abs(s) * hz, wz = Math.abs(s) * hx + Math.abs(c) * hz;
-    const px = c * cx + s * cz + page.position[3 * j], pz = -s * cx + c * cz + page.position[3 * j + 2];
-    const b = page.bounds;
-    b[6 * j] = px - wx; b[6 * j + 1] = boxScratch[1] + page.position[3 * j + 1]; b[6 * j + 2] = pz - wz;
-    b[6 * j + 3] = px + wx; b[6 * j + 4] = boxScratch[4] + page.position[3 * j + 1]; b[6 * j + 5] = pz + wz;
+    writePoseRows(data, quats, trans, tmp, page.staging, base, localBox);
+    writeRootRows(root, page.alive[j], page.staging, base + rootRow);
+    rootBounds(localBox, root, page.bounds, 6 * j);
     page.dirtyLo = Math.min(page.dirtyLo, j);
     page.dirtyHi = Math.max(page.dirtyHi, j);
+  }
+  function writeCurrent(page, j) {
+    const m = page.motions[j];
+    writeInstance(page, j, m.quats, m.trans, m.root);
   }
 
   function refreshBounds(page) {
@@ -236,9 +244,17 @@ export async function createCreaturePopulation(renderer, options = {}) {
     return { page, j: id - page.first };
   }
 
-  function setTick(n) {
-    tick = n;
-    for (const page of pages) for (let j = 0; j < page.size; j++) if (page.alive[j]) writeInstance(page, j);
+  // Every live body `n` fixed steps on (stepTicks and update share it: same ticks, same state).
+  function advance(n) {
+    for (const page of pages) {
+      for (let j = 0; j < page.size; j++) {
+        if (!page.alive[j]) continue;
+        const m = page.motions[j];
+        for (let k = 0; k < n; k++) m.step();
+      }
+    }
+    tick += n;
+    stats.ticks += n;
   }
 
   const population = {
@@ -257,7 +273,14 @@ export async function createCreaturePopulation(renderer, options = {}) {
     deformBytesPerBody,
     get count() { return pages.reduce((n, p) => n + p.alive.reduce((a, b) => a + b, 0), 0); },
     stats,
-    /** Validate and write one body: O(slots), no geometry, material or pipeline is created. */
+    /** The support, gravity and water providers every body of this population stands, falls and swims on. */
+    support, gravity, water,
+    /**
+     * Validate and add one body at `position` (its path starts there; the locomotion core puts it on the
+     * support, on the water or at the flyer's altitude), heading from its seed. Builds its CPU motion state
+     * and writes O(slots) rows: no geometry, material, buffer or pipeline is created. Its motion starts at its
+     * own tick 0.
+     */
     spawn({ seed = 0, position = [0, 0, 0] } = {}) {
       if (!Number.isInteger(seed) || seed < 0 || seed > 0xffffffff) throw new Error(`spawn.seed: an integer in [0, 2^32) (got ${seed})`);
       if (!Array.isArray(position) || position.length !== 3 || !position.every(Number.isFinite)) {
@@ -266,13 +289,11 @@ export async function createCreaturePopulation(renderer, options = {}) {
       for (const page of pages) {
         for (let j = 0; j < page.size; j++) {
           if (page.alive[j]) continue;
-          const { tickOffset, yaw } = instanceOffset(seed, data.lcg, data.sway.period);
+          page.motions[j] = createMotion(data.motion, data.lcg, { support, gravity, water, seed, position });
           page.alive[j] = 1;
           page.seed[j] = seed;
-          page.tickOffset[j] = tickOffset;
-          page.yaw[j] = yaw;
-          page.position.set(position, 3 * j);
-          writeInstance(page, j);
+          page.spawnTick[j] = tick;
+          writeCurrent(page, j);
           stats.spawns += 1;
           return page.first + j;
         }
@@ -282,21 +303,55 @@ export async function createCreaturePopulation(renderer, options = {}) {
     despawn(id) {
       const { page, j } = locate(id);
       page.alive[j] = 0;
+      page.motions[j] = null;
       page.staging.fill(0, j * floatsPerInstance, (j + 1) * floatsPerInstance);
       page.dirtyLo = Math.min(page.dirtyLo, j);
       page.dirtyHi = Math.max(page.dirtyHi, j);
     },
-    /** Advance whole ticks (the sway is closed form, so this equals seekTick(tick + n)). */
+    /** Advance every body `n` whole fixed steps and upload the current step's pose (no interpolation). */
     stepTicks(n = 1) {
-      stats.ticks += n;
-      setTick(tick + n);
+      if (!Number.isInteger(n) || n < 0) throw new Error(`stepTicks: a non-negative integer (got ${n})`);
+      advance(n);
+      for (const page of pages) for (let j = 0; j < page.size; j++) if (page.alive[j]) writeCurrent(page, j);
       return flush();
     },
+    /**
+     * Put the population at tick `n`: each body re-simulated from its spawn to its own tick
+     * n − spawnTick (0 if it was spawned later), so the state equals stepping there tick by tick.
+     */
     seekTick(n) {
       if (!Number.isInteger(n) || n < 0) throw new Error(`seekTick: a non-negative integer (got ${n})`);
-      setTick(n);
+      for (const page of pages) {
+        for (let j = 0; j < page.size; j++) {
+          if (!page.alive[j]) continue;
+          page.motions[j].seekTick(Math.max(0, n - page.spawnTick[j]));
+          writeCurrent(page, j);
+        }
+      }
+      tick = n;
+      driver.reset();
       return flush();
     },
+    /**
+     * One render frame of `dt` seconds: the fixed-step driver (dt clamped to [0, 0.25] s, accumulator
+     * capped at 0.25 s) runs the whole steps due, then every body is drawn at the render pose interpolated
+     * between its previous and current step. Returns the number of steps run.
+     */
+    update(dt) {
+      const steps = driver.advance(dt);
+      advance(steps);
+      for (const page of pages) {
+        for (let j = 0; j < page.size; j++) {
+          if (!page.alive[j]) continue;
+          page.motions[j].renderPose(driver.alpha, renderQuats, renderTrans, renderRoot);
+          writeInstance(page, j, renderQuats, renderTrans, renderRoot);
+        }
+      }
+      flush();
+      return steps;
+    },
+    /** The fixed-step driver (hz, alpha, accumulator) update() uses. */
+    driver,
     /** Upload whatever spawn/despawn left dirty (called by the owner before rendering). */
     flush,
     /** Internal: the page holding instance `id` and its index there. */
@@ -306,8 +361,14 @@ export async function createCreaturePopulation(renderer, options = {}) {
     },
     instance(id) {
       const { page, j } = locate(id);
-      return { index: j, alive: page.alive[j] === 1, seed: page.seed[j], tickOffset: page.tickOffset[j], yaw: page.yaw[j],
-        position: Array.from(page.position.subarray(3 * j, 3 * j + 3)), bounds: Array.from(page.bounds.subarray(6 * j, 6 * j + 6)) };
+      const m = page.motions[j];
+      return { index: j, alive: page.alive[j] === 1, seed: page.seed[j], spawnTick: page.spawnTick[j],
+        tick: m ? m.tick : null, root: m ? Array.from(m.root) : null, bounds: Array.from(page.bounds.subarray(6 * j, 6 * j + 6)) };
+    },
+    /** The locomotion core of a live instance (createMotion: state, gates, renderPose), or null. */
+    motion(id) {
+      const { page, j } = locate(id);
+      return page.motions[j];
     },
     /** Pose rows of one instance from the CPU staging copy (what the next upload sends). */
     stagedPose(id) {

@@ -7,7 +7,7 @@ import {
   Fn, abs, attribute, cross, float, instanceIndex, int, mix, normalLocal, normalize, select, varyingProperty,
   vec3,
 } from 'three/tsl';
-import { rootRotate } from './material.js';
+import { rootNormal, rootPoint } from './material.js';
 
 /** A unit capsule along +y (hemispheres at y = ±0.5) with per-vertex end (0 at a, 1 at b). */
 function shellGeometry() {
@@ -46,9 +46,9 @@ export function createShellMesh(layout, pose, name) {
     const centre = mix(rowA.xyz, rowB.xyz, end);
     const radius = mix(rowA.w, rowB.w, end);
     vColour.assign(pose.element(o.add(2)).yzw);
-    normalLocal.assign(rootRotate(root1, n));
+    normalLocal.assign(rootNormal(root1, n));
     const p = centre.add(n.mul(radius));
-    return select(root0.w.greaterThan(0.5), rootRotate(root1, p).add(root0.xyz), vec3(0));
+    return select(root0.w.greaterThan(0.5), rootPoint(root1, p).add(root0.xyz), vec3(0));
   })();
   material.colorNode = vColour;
   const mesh = new THREE.Mesh(shellGeometry(), material);

@@ -1,11 +1,14 @@
 // Vector and quaternion helpers (xyzw) for the locomotion core, written term by term exactly as
 // creaturegen's Python reference (motion/quat.py): Python and JS agree to ~1e-15 only when both evaluate
-// the same expression tree. Every function writes into `out` at offset `o`; nothing allocates.
+// the same expression tree. Every function reads vectors from (array, offset) and writes into `out` at
+// offset `o`: no double crosses a call as an argument or a return value, so a call V8 does not inline
+// boxes nothing, and nothing allocates.
 
-import { pcos, psin } from './trig.js';
+import { sincos } from './trig.js';
 
-/** R(q)·v by v + 2w(u×v) + 2u×(u×v). */
-export function rotate(q, qo, vx, vy, vz, out, o) {
+/** R(q)·v by v + 2w(u×v) + 2u×(u×v); v at v[vo..vo+2]. */
+export function rotate(q, qo, v, vo, out, o) {
+  const vx = v[vo], vy = v[vo + 1], vz = v[vo + 2];
   const x = q[qo], y = q[qo + 1], z = q[qo + 2], w = q[qo + 3];
   const cx = y * vz - z * vy;
   const cy = z * vx - x * vz;
@@ -25,20 +28,28 @@ export function mul(a, ao, b, bo, out, o) {
   out[o + 3] = aw * bw - ax * bx - ay * by - az * bz;
 }
 
-export function axisAngle(ax, ay, az, angle, out, o) {
-  const half = 0.5 * angle;
-  const s = psin(half);
-  out[o] = ax * s; out[o + 1] = ay * s; out[o + 2] = az * s; out[o + 3] = pcos(half);
+/** The rotation about unit axis a[ao..ao+2] by the angle a[ao+3]. */
+export function axisAngle(a, ao, out, o) {
+  const ax = a[ao], ay = a[ao + 1], az = a[ao + 2];
+  HALF[2] = 0.5 * a[ao + 3];
+  sincos(HALF, 2, HALF, 0);
+  const s = HALF[0];
+  out[o] = ax * s; out[o + 1] = ay * s; out[o + 2] = az * s; out[o + 3] = HALF[1];
 }
 
-/** Unit (vx, vy, vz) into out. */
-export function normalizeInto(vx, vy, vz, out, o) {
+const HALF = new Float64Array(3);
+
+/** Unit v[vo..vo+2] into out. */
+export function normalizeInto(v, vo, out, o) {
+  const vx = v[vo], vy = v[vo + 1], vz = v[vo + 2];
   const n = Math.sqrt(vx * vx + vy * vy + vz * vz);
   out[o] = vx / n; out[o + 1] = vy / n; out[o + 2] = vz / n;
 }
 
-/** The unit component of hint orthogonal to unit u (x axis, then z, stand in when they are parallel). */
-export function gramSchmidt(hx, hy, hz, ux, uy, uz, out, o) {
+/** The unit component of hint h[ho..] orthogonal to unit u[uo..] (x axis, then z, stand in when they are
+ * parallel). */
+export function gramSchmidt(hv, ho, uv, uo, out, o) {
+  const hx = hv[ho], hy = hv[ho + 1], hz = hv[ho + 2], ux = uv[uo], uy = uv[uo + 1], uz = uv[uo + 2];
   let h = hx * ux + hy * uy + hz * uz;
   let vx = hx - h * ux, vy = hy - h * uy, vz = hz - h * uz;
   if (Math.sqrt(vx * vx + vy * vy + vz * vz) < 1e-9) {
@@ -46,7 +57,8 @@ export function gramSchmidt(hx, hy, hz, ux, uy, uz, out, o) {
     h = fx * ux + 0 * uy + fz * uz;
     vx = fx - h * ux; vy = 0 - h * uy; vz = fz - h * uz;
   }
-  normalizeInto(vx, vy, vz, out, o);
+  out[o] = vx; out[o + 1] = vy; out[o + 2] = vz;
+  normalizeInto(out, o, out, o);
 }
 
 /** The rotation taking frame (u0, v0, u0×v0) to (u1, v1, u1×v1), by Shepperd's method; f holds
@@ -75,12 +87,14 @@ export function fromFrames(f, out, o) {
   }
 }
 
+const HALF_TURN_AXES = new Float64Array([1, 0, 0, 0, 1, 0]);
+
 /** The shortest rotation taking unit e0 to unit e1 (a half-turn about a perpendicular when opposite). */
-export function fromTo(e0x, e0y, e0z, e1x, e1y, e1z, out, o) {
+export function fromTo(e0, e0o, e1, e1o, out, o) {
+  const e0x = e0[e0o], e0y = e0[e0o + 1], e0z = e0[e0o + 2], e1x = e1[e1o], e1y = e1[e1o + 1], e1z = e1[e1o + 2];
   const d = e0x * e1x + e0y * e1y + e0z * e1z;
   if (d < -1 + 1e-12) {
-    const near = Math.abs(e0x) < 0.9;
-    gramSchmidt(near ? 1 : 0, near ? 0 : 1, 0, e0x, e0y, e0z, out, o);
+    gramSchmidt(HALF_TURN_AXES, Math.abs(e0x) < 0.9 ? 0 : 3, e0, e0o, out, o);
     out[o + 3] = 0;
     return;
   }

@@ -7,7 +7,7 @@ export { bodyFunctions, bodyVertex, layoutOf } from './body.js';
 export {
   DEFORM_STRIDE, RECORD_STRIDE, createDeformKernel, deformStorage, deformView, dispatchDeform, recordInputs, vertexRecords,
 } from './deform.js';
-export { DEBUG_MODES, checkDebugMode, createBodyMaterial, rootRotate } from './material.js';
+export { DEBUG_MODES, checkDebugMode, createBodyMaterial, rootNormal, rootPoint, rootRotate } from './material.js';
 export { createShellMesh } from './shell.js';
 export { assertWebGPU, createCreaturePopulation, programStorage, surfaceGeometry } from './population.js';
 export { createDiagnostics } from './diagnostics.js';

@@ -11,12 +11,12 @@
 // Integer ticks are authoritative: seekTick(n) resets and steps n times, so it equals n step() calls bit
 // for bit. Nothing allocates after createMotion (typed scratch only); the only variation is the seeded LCG.
 
-import { instanceOffset } from '../lcg.js';
+import { instanceYaw } from '../lcg.js';
 import { hashBytes } from '../hash.js';
 import { axisAngle, fromFrames, fromTo, gramSchmidt, mul, normalizeInto, rotate } from './quat.js';
 import { SWIMMER_CHANNELS, createFlatGround, createGravity, toLocal, toWorld } from './providers.js';
 import { derive } from './derived.js';
-import { pcos, psin } from './trig.js';
+import { sincos } from './trig.js';
 
 const WALKERS = ['biped', 'quadruped', 'hexapod'];
 const GATE_NAMES = ['plantDrift', 'ikResidual', 'drawnFoot', 'clampedTicks', 'plantedSamples', 'bothSwingTicks', 'steps',
@@ -24,6 +24,10 @@ const GATE_NAMES = ['plantDrift', 'ikResidual', 'drawnFoot', 'clampedTicks', 'pl
 const G = Object.freeze(Object.fromEntries(GATE_NAMES.map((name, i) => [name, i])));
 
 export class TierRefusedError extends Error {}
+
+/** |(x, y, z)| as sqrt((x² + y²) + z²), the reference's quat.norm3 (not Math.hypot: a builtin call that
+ * boxes its arguments, and whose rounding differs from Python's math.hypot). */
+const norm3 = (x, y, z) => Math.sqrt(x * x + y * y + z * z);
 
 export function createMotion(data, lcg, { support = createFlatGround(), gravity = createGravity(), water = null, seed = 0, position = [0, 0, 0] } = {}) {
   const m = data;
@@ -35,7 +39,7 @@ export function createMotion(data, lcg, { support = createFlatGround(), gravity 
   }
   const gravity0 = gravity.at(0, new Float64Array(3));
   const d = derive(m, gravity0);
-  const { yaw } = instanceOffset(seed, lcg, 1);
+  const yaw = instanceYaw(seed, lcg);
   const theta0 = -yaw;
   const pos = Float64Array.from(position);
   const S = m.parent.length;
@@ -81,11 +85,23 @@ export function createMotion(data, lcg, { support = createFlatGround(), gravity 
   const turned = new Float64Array(3);
   const frames = new Float64Array(12);
   const ik = new Float64Array(16); // knee 0..2, foot 3..5, flags 6 (clamped), 7 (residual)
-  const grav = new Float64Array(3);
+  const grav = Float64Array.from(gravity0);
+  const staticFrame = support.frame(0, new Float64Array(12));
   const anchorLocal = new Float64Array(3);
   const anchorWorld = new Float64Array(3);
+  const beforeWorld = new Float64Array(3);
   const localNodes = new Float64Array(3 * Math.max(1, ...m.ropes.map((r) => r.rest.length)));
   const e0 = new Float64Array(3);
+  const hinge1 = new Float64Array(3);
+  const u3 = new Float64Array(3);
+  const n3 = new Float64Array(3);
+  const g3 = new Float64Array(3);
+  const sc = new Float64Array(3); // sin, cos, angle (trig.js sincos)
+  const dist1 = new Float64Array(1);
+  const still = new Float64Array(3);
+  const axis4 = new Float64Array(4);
+  const LEVEL = new Float64Array([0, 1]); // lift 0, squash 1
+  const hopLift = hopOut.subarray(1, 3); // the hop's (lift, squash)
   const e1 = new Float64Array(3);
   const q = new Float64Array(4);
 
@@ -103,15 +119,19 @@ export function createMotion(data, lcg, { support = createFlatGround(), gravity 
 
   // --- root ------------------------------------------------------------------------------------------
 
-  function pathAt(dist, out) {
+  // Doubles reach the helpers below through typed scratch arrays, never as arguments (see quat.js).
+  function pathAt(dv, out) {
     const radius = m.pathRadius;
-    const theta = theta0 + dist / radius;
-    out[0] = centre[0] + radius * pcos(theta);
-    out[1] = centre[2] + radius * psin(theta);
-    out[2] = -theta;
+    sc[2] = theta0 + dv[0] / radius;
+    sincos(sc, 2, sc, 0);
+    out[0] = centre[0] + radius * sc[1];
+    out[1] = centre[2] + radius * sc[0];
+    out[2] = -sc[2];
   }
 
-  function settle(f, c, s) {
+  /** How far the upright body sinks on a tilted support (heading c, s = hs[0], hs[1]) into hs[2]. */
+  function settle(f, hs) {
+    const c = hs[0], s = hs[1];
     const ny = f[7];
     let lowest = 0;
     for (let i = 0; i < L; i++) {
@@ -121,17 +141,22 @@ export function createMotion(data, lcg, { support = createFlatGround(), gravity 
       const dy = -(f[6] * rx + f[8] * rz) / ny;
       if (dy < lowest) lowest = dy;
     }
-    return lowest;
+    hs[2] = lowest;
   }
 
-  function grounded(f, u, w, psi, lift, squash, out) {
-    toWorld(f, u, 0, w, v3, 0);
-    const sp = psin(psi), cp = pcos(psi);
+  /** Root on the support at (u, w) = p[0], p[1], heading ψ = p[2]; ls = (lift, squash). */
+  function grounded(f, p, ls, out) {
+    const psi = p[2], squash = ls[1];
+    let lift = ls[0];
+    g3[0] = p[0]; g3[1] = 0; g3[2] = p[1];
+    toWorld(f, g3, 0, v3, 0);
+    sincos(p, 2, sc, 0);
+    const sp = sc[0], cp = sc[1];
     const fx = sp * f[3] + cp * f[9];
     const fz = sp * f[5] + cp * f[11];
     const norm = Math.sqrt(fx * fx + fz * fz);
     const c = fz / norm, s = fx / norm;
-    if (L) lift = lift + settle(f, c, s);
+    if (L) { sc[0] = c; sc[1] = s; settle(f, sc); lift = lift + sc[2]; }
     out[0] = v3[0]; out[1] = v3[1] + lift - m.groundY * squash; out[2] = v3[2]; out[3] = c; out[4] = s; out[5] = squash;
   }
 
@@ -142,7 +167,11 @@ export function createMotion(data, lcg, { support = createFlatGround(), gravity 
     let r = n % d.hopCycle;
     if (r < d.hopIdle) { out[0] = k * hopLength; out[1] = 0; out[2] = 1; return; }
     r -= d.hopIdle;
-    if (r < d.crouch) { out[0] = k * hopLength; out[1] = 0; out[2] = 1 - c.hopSquash * psin(Math.PI * (r / d.crouch)); return; }
+    if (r < d.crouch) {
+      sc[2] = Math.PI * (r / d.crouch);
+      sincos(sc, 2, sc, 0);
+      out[0] = k * hopLength; out[1] = 0; out[2] = 1 - c.hopSquash * sc[0]; return;
+    }
     r -= d.crouch;
     if (r < d.air) {
       const ts = r * d.dt;
@@ -154,33 +183,42 @@ export function createMotion(data, lcg, { support = createFlatGround(), gravity 
       return;
     }
     r -= d.air;
-    out[0] = (k + 1) * hopLength; out[1] = 0; out[2] = 1 - c.hopSquash * psin(Math.PI * (r / d.land));
+    sc[2] = Math.PI * (r / d.land);
+    sincos(sc, 2, sc, 0);
+    out[0] = (k + 1) * hopLength; out[1] = 0; out[2] = 1 - c.hopSquash * sc[0];
   }
 
   /** Support frame and root (x, y, z, cos yaw, sin yaw, squash) at tick n. */
   function rootAt(n, f, out) {
     const time = n * d.dt;
-    support.frame(time, f);
+    // A static support (flat ground, the slope) was sampled once; a moving one is asked every tick.
+    if (support.static === true) f.set(staticFrame);
+    else support.frame(time, f);
+    dist1[0] = m.speed * time;
     if (isWalker) {
-      pathAt(m.speed * time, path);
-      grounded(f, path[0], path[1], path[2], 0, 1, out);
+      pathAt(dist1, path);
+      grounded(f, path, LEVEL, out);
     } else if (kind === 'hopper') {
       hopAt(n, hopOut);
-      pathAt(hopOut[0], path);
-      grounded(f, path[0], path[1], path[2], hopOut[1], hopOut[2], out);
+      pathAt(hopOut, path);
+      grounded(f, path, hopLift, out);
     } else if (kind === 'flyer') {
-      pathAt(m.speed * time, path);
-      out[0] = path[0]; out[1] = m.altitude - m.groundY; out[2] = path[1]; out[3] = pcos(path[2]); out[4] = psin(path[2]); out[5] = 1;
+      pathAt(dist1, path);
+      sincos(path, 2, sc, 0);
+      out[0] = path[0]; out[1] = m.altitude - m.groundY; out[2] = path[1]; out[3] = sc[1]; out[4] = sc[0]; out[5] = 1;
     } else if (kind === 'swimmer') {
-      pathAt(m.speed * time, path);
-      out[0] = path[0]; out[1] = swim[0]; out[2] = path[1]; out[3] = pcos(path[2]); out[4] = psin(path[2]); out[5] = 1;
+      pathAt(dist1, path);
+      sincos(path, 2, sc, 0);
+      out[0] = path[0]; out[1] = swim[0]; out[2] = path[1]; out[3] = sc[1]; out[4] = sc[0]; out[5] = 1;
     } else {
-      grounded(f, pos[0], pos[2], -theta0, 0, 1, out);
+      still[0] = pos[0]; still[1] = pos[2]; still[2] = -theta0;
+      grounded(f, still, LEVEL, out);
     }
   }
 
   /** Creature-local → world: p + R_yaw(S·x), S = diag(1/√s, s, 1/√s). */
-  function toWorldRoot(r, x0, x1, x2, out, o) {
+  function toWorldRoot(r, x, xo, out, o) {
+    const x0 = x[xo], x1 = x[xo + 1], x2 = x[xo + 2];
     const c = r[3], s = r[4], squash = r[5];
     const k = 1 / Math.sqrt(squash);
     const vx = x0 * k, vy = x1 * squash, vz = x2 * k;
@@ -189,7 +227,8 @@ export function createMotion(data, lcg, { support = createFlatGround(), gravity 
     out[o + 2] = r[2] + (-s * vx + c * vz);
   }
 
-  function toLocalRoot(r, x0, x1, x2, out, o) {
+  function toLocalRoot(r, x, xo, out, o) {
+    const x0 = x[xo], x1 = x[xo + 1], x2 = x[xo + 2];
     const c = r[3], s = r[4], squash = r[5];
     const vx = x0 - r[0], vy = x1 - r[1], vz = x2 - r[2];
     const sq = Math.sqrt(squash);
@@ -205,14 +244,15 @@ export function createMotion(data, lcg, { support = createFlatGround(), gravity 
     if (kind === 'swimmer') swimStep(n, integrate);
     rootAt(n, frame, root);
     if (kind === 'hopper') hopGates(n);
-    basePose(time);
+    basePose(n);
     if (L) gait(n, integrate);
     if (m.ropes.length) ropes(integrate);
   }
 
   function swimStep(n, integrate) {
     const time = n * d.dt;
-    pathAt(m.speed * time, path);
+    dist1[0] = m.speed * time;
+    pathAt(dist1, path);
     water.sample(path[0], path[1], time, sample);
     const eta = sample.freeSurfacePoint[1];
     const tgt = eta - d.swimDepth - m.centreY;
@@ -242,21 +282,31 @@ export function createMotion(data, lcg, { support = createFlatGround(), gravity 
     }
   }
 
-  function basePose(time) {
+  function basePose(n) {
+    const time = n * d.dt;
     hasLocal.fill(0);
     if (kind === 'flyer') {
       for (let i = 0; i < m.roots.length; i++) { const r = m.roots[i]; locals[4 * r] = 0; locals[4 * r + 1] = 0; locals[4 * r + 2] = d.bankHalfSin; locals[4 * r + 3] = d.bankHalfCos; hasLocal[r] = 1; }
-      const flap = psin(2 * Math.PI * d.flapHz * time);
-      for (let i = 0; i < m.wings.length; i++) { const w = m.wings[i]; axisAngle(0, 0, 1, w.sign * w.amplitude * flap, locals, 4 * w.slot); hasLocal[w.slot] = 1; }
+      sc[2] = 2 * Math.PI * d.flapHz * time;
+      sincos(sc, 2, sc, 0);
+      const flap = sc[0];
+      for (let i = 0; i < m.wings.length; i++) {
+        const w = m.wings[i];
+        axis4[0] = 0; axis4[1] = 0; axis4[2] = 1; axis4[3] = w.sign * w.amplitude * flap;
+        axisAngle(axis4, 0, locals, 4 * w.slot); hasLocal[w.slot] = 1;
+      }
     } else if (kind === 'swimmer' && d.undulationHz > 0) {
-      const angle = m.undulation * psin(2 * Math.PI * d.undulationHz * time);
-      for (let i = 0; i < m.roots.length; i++) { const r = m.roots[i]; axisAngle(0, 1, 0, angle, locals, 4 * r); hasLocal[r] = 1; }
+      sc[2] = 2 * Math.PI * d.undulationHz * time;
+      sincos(sc, 2, sc, 0);
+      const angle = m.undulation * sc[0];
+      axis4[0] = 0; axis4[1] = 1; axis4[2] = 0; axis4[3] = angle;
+      for (let i = 0; i < m.roots.length; i++) { const r = m.roots[i]; axisAngle(axis4, 0, locals, 4 * r); hasLocal[r] = 1; }
     }
     for (let k = 0; k < m.order.length; k++) {
       const s = m.order[k];
       if (!hasLocal[s]) { locals[4 * s] = 0; locals[4 * s + 1] = 0; locals[4 * s + 2] = 0; locals[4 * s + 3] = 1; }
       const pv = m.pivot[s];
-      rotate(locals, 4 * s, pv[0], pv[1], pv[2], turned, 0);
+      rotate(locals, 4 * s, pv, 0, turned, 0);
       const ax = pv[0] - turned[0], ay = pv[1] - turned[1], az = pv[2] - turned[2];
       const p = m.parent[s];
       if (p < 0) {
@@ -264,7 +314,8 @@ export function createMotion(data, lcg, { support = createFlatGround(), gravity 
         trans[3 * s] = ax; trans[3 * s + 1] = ay; trans[3 * s + 2] = az;
       } else {
         mul(quats, 4 * p, locals, 4 * s, quats, 4 * s);
-        rotate(quats, 4 * p, ax, ay, az, turned, 0);
+        v3[0] = ax; v3[1] = ay; v3[2] = az;
+        rotate(quats, 4 * p, v3, 0, turned, 0);
         trans[3 * s] = turned[0] + trans[3 * p]; trans[3 * s + 1] = turned[1] + trans[3 * p + 1]; trans[3 * s + 2] = turned[2] + trans[3 * p + 2];
       }
     }
@@ -274,8 +325,8 @@ export function createMotion(data, lcg, { support = createFlatGround(), gravity 
 
   /** Support-local home of a foot: the rest foot under root r, on the support frame f. */
   function homeIn(leg, f, r, out) {
-    toWorldRoot(r, leg.foot[0], leg.foot[1], leg.foot[2], v3, 0);
-    toLocal(f, v3[0], v3[1], v3[2], out, 0);
+    toWorldRoot(r, leg.foot, 0, v3, 0);
+    toLocal(f, v3, 0, out, 0);
     out[1] = 0;
   }
 
@@ -284,21 +335,23 @@ export function createMotion(data, lcg, { support = createFlatGround(), gravity 
     if (m.speed <= 0) { plant[3 * i] = home[0]; plant[3 * i + 1] = 0; plant[3 * i + 2] = home[2]; return; }
     const lead = m.constants.stepLead * m.stepLength;
     const back = m.speed * d.dt * (d.cycle - d.swing - leg.group * d.window);
-    pathAt(0, path);
-    const psi = path[2];
+    dist1[0] = 0;
+    pathAt(dist1, path);
+    sincos(path, 2, sc, 0);
     const offset = lead - back;
-    plant[3 * i] = home[0] + psin(psi) * offset; plant[3 * i + 1] = 0; plant[3 * i + 2] = home[2] + pcos(psi) * offset;
+    plant[3 * i] = home[0] + sc[0] * offset; plant[3 * i + 1] = 0; plant[3 * i + 2] = home[2] + sc[1] * offset;
   }
 
   /** Two-bone IK into the leg's slots (motion/ik.py); ik[0..2] knee, ik[3..5] foot, ik[6] clamped, ik[7] residual. */
-  function solveLeg(leg, tx, ty, tz) {
+  function solveLeg(leg, t) {
     const hip = leg.hip, knee0 = leg.knee, foot0 = leg.foot, hint = leg.hint, a = leg.a, b = leg.b;
-    const dx = tx - hip[0], dy = ty - hip[1], dz = tz - hip[2];
+    const dx = t[0] - hip[0], dy = t[1] - hip[1], dz = t[2] - hip[2];
     const dist = Math.sqrt(dx * dx + dy * dy + dz * dz);
     let ux = 0, uy = -1, uz = 0;
     if (dist !== 0) { ux = dx / dist; uy = dy / dist; uz = dz / dist; }
     const reach = Math.min(Math.max(dist, leg.reachMin), leg.reachMax);
-    gramSchmidt(hint[0], hint[1], hint[2], ux, uy, uz, w3, 0);
+    u3[0] = ux; u3[1] = uy; u3[2] = uz;
+    gramSchmidt(hint, 0, u3, 0, w3, 0);
     let cosA = (a * a + reach * reach - b * b) / (2 * a * reach);
     cosA = Math.min(Math.max(cosA, -1), 1);
     const sinA = Math.sqrt(1 - cosA * cosA);
@@ -306,26 +359,34 @@ export function createMotion(data, lcg, { support = createFlatGround(), gravity 
     const ky = hip[1] + a * (cosA * uy + sinA * w3[1]);
     const kz = hip[2] + a * (cosA * uz + sinA * w3[2]);
     const fx = hip[0] + reach * ux, fy = hip[1] + reach * uy, fz = hip[2] + reach * uz;
+    // Frames: the bone and the knee's hinge axis (rest: leg.hinge; posed: u × v), motion/ik.py.
+    const h0 = leg.hinge;
+    n3[0] = uy * w3[2] - uz * w3[1]; n3[1] = uz * w3[0] - ux * w3[2]; n3[2] = ux * w3[1] - uy * w3[0];
+    normalizeInto(n3, 0, hinge1, 0);
     // thigh: rest frame (0..5), posed frame (6..11)
-    normalizeInto(knee0[0] - hip[0], knee0[1] - hip[1], knee0[2] - hip[2], frames, 0);
-    gramSchmidt(hint[0], hint[1], hint[2], frames[0], frames[1], frames[2], frames, 3);
-    normalizeInto(kx - hip[0], ky - hip[1], kz - hip[2], frames, 6);
-    gramSchmidt(hint[0], hint[1], hint[2], frames[6], frames[7], frames[8], frames, 9);
+    n3[0] = knee0[0] - hip[0]; n3[1] = knee0[1] - hip[1]; n3[2] = knee0[2] - hip[2];
+    normalizeInto(n3, 0, frames, 0);
+    gramSchmidt(h0, 0, frames, 0, frames, 3);
+    n3[0] = kx - hip[0]; n3[1] = ky - hip[1]; n3[2] = kz - hip[2];
+    normalizeInto(n3, 0, frames, 6);
+    gramSchmidt(hinge1, 0, frames, 6, frames, 9);
     const up = leg.upper, lo = leg.lower;
     fromFrames(frames, quats, 4 * up);
-    rotate(quats, 4 * up, hip[0], hip[1], hip[2], turned, 0);
+    rotate(quats, 4 * up, hip, 0, turned, 0);
     trans[3 * up] = hip[0] - turned[0]; trans[3 * up + 1] = hip[1] - turned[1]; trans[3 * up + 2] = hip[2] - turned[2];
-    normalizeInto(foot0[0] - knee0[0], foot0[1] - knee0[1], foot0[2] - knee0[2], frames, 0);
-    gramSchmidt(hint[0], hint[1], hint[2], frames[0], frames[1], frames[2], frames, 3);
-    normalizeInto(fx - kx, fy - ky, fz - kz, frames, 6);
-    gramSchmidt(hint[0], hint[1], hint[2], frames[6], frames[7], frames[8], frames, 9);
+    n3[0] = foot0[0] - knee0[0]; n3[1] = foot0[1] - knee0[1]; n3[2] = foot0[2] - knee0[2];
+    normalizeInto(n3, 0, frames, 0);
+    gramSchmidt(h0, 0, frames, 0, frames, 3);
+    n3[0] = fx - kx; n3[1] = fy - ky; n3[2] = fz - kz;
+    normalizeInto(n3, 0, frames, 6);
+    gramSchmidt(hinge1, 0, frames, 6, frames, 9);
     fromFrames(frames, quats, 4 * lo);
-    rotate(quats, 4 * lo, knee0[0], knee0[1], knee0[2], turned, 0);
+    rotate(quats, 4 * lo, knee0, 0, turned, 0);
     trans[3 * lo] = kx - turned[0]; trans[3 * lo + 1] = ky - turned[1]; trans[3 * lo + 2] = kz - turned[2];
     ik[0] = kx; ik[1] = ky; ik[2] = kz; ik[3] = fx; ik[4] = fy; ik[5] = fz;
     ik[6] = reach !== dist ? 1 : 0;
-    const thigh = Math.hypot(kx - hip[0], ky - hip[1], kz - hip[2]);
-    const shin = Math.hypot(fx - kx, fy - ky, fz - kz);
+    const thigh = norm3(kx - hip[0], ky - hip[1], kz - hip[2]);
+    const shin = norm3(fx - kx, fy - ky, fz - kz);
     ik[7] = Math.max(Math.abs(thigh - a), Math.abs(shin - b)) / (a + b);
   }
 
@@ -367,20 +428,21 @@ export function createMotion(data, lcg, { support = createFlatGround(), gravity 
         local[1] = m.stepHeight * (4 * tau * (1 - tau));
         local[2] = swingFrom[o + 2] + (swingTo[o + 2] - swingFrom[o + 2]) * sigma;
       }
-      toWorld(frame, local[0], local[1], local[2], v3, 0);
-      toLocalRoot(root, v3[0], v3[1], v3[2], target, 0);
-      solveLeg(leg, target[0], target[1], target[2]);
+      toWorld(frame, local, 0, v3, 0);
+      toLocalRoot(root, v3, 0, target, 0);
+      solveLeg(leg, target);
       const span = leg.a + leg.b;
       gv[G.ikResidual] = Math.max(gv[G.ikResidual], ik[7]);
-      rotate(quats, 4 * leg.lower, leg.foot[0], leg.foot[1], leg.foot[2], v3, 0);
+      rotate(quats, 4 * leg.lower, leg.foot, 0, v3, 0);
       const lo = 3 * leg.lower;
       const drawnX = v3[0] + trans[lo], drawnY = v3[1] + trans[lo + 1], drawnZ = v3[2] + trans[lo + 2];
-      gv[G.drawnFoot] = Math.max(gv[G.drawnFoot], Math.hypot(drawnX - ik[3], drawnY - ik[4], drawnZ - ik[5]) / span);
+      gv[G.drawnFoot] = Math.max(gv[G.drawnFoot], norm3(drawnX - ik[3], drawnY - ik[4], drawnZ - ik[5]) / span);
       if (ik[6]) gv[G.clampedTicks] += 1;
       else if (planted[i]) {
-        toWorldRoot(root, drawnX, drawnY, drawnZ, v3, 0);
-        toLocal(frame, v3[0], v3[1], v3[2], w3, 0);
-        gv[G.plantDrift] = Math.max(gv[G.plantDrift], Math.hypot(w3[0] - plant[o], w3[1] - plant[o + 1], w3[2] - plant[o + 2]) / span);
+        n3[0] = drawnX; n3[1] = drawnY; n3[2] = drawnZ;
+        toWorldRoot(root, n3, 0, v3, 0);
+        toLocal(frame, v3, 0, w3, 0);
+        gv[G.plantDrift] = Math.max(gv[G.plantDrift], norm3(w3[0] - plant[o], w3[1] - plant[o + 1], w3[2] - plant[o + 2]) / span);
         gv[G.plantedSamples] += 1;
       }
     }
@@ -392,8 +454,32 @@ export function createMotion(data, lcg, { support = createFlatGround(), gravity 
   function anchorPoint(rope, j, out, o) {
     const p = rope.parent;
     const x = rope.rest[j];
-    rotate(quats, 4 * p, x[0], x[1], x[2], out, o);
+    rotate(quats, 4 * p, x, 0, out, o);
     out[o] += trans[3 * p]; out[o + 1] += trans[3 * p + 1]; out[o + 2] += trans[3 * p + 2];
+  }
+
+  // The bend limit (motion/simulate.py _bend): node j's neighbours at least bendMin apart; the anchor and
+  // the point before it on the body are fixed, so the first two constraints move only the far node.
+  function bend(cur, count, rope) {
+    const bendMin = rope.bendMin;
+    for (let j = 0; j < count - 1; j++) {
+      const b = 3 * (j + 1);
+      const ax = j === 0 ? beforeWorld[0] : cur[3 * (j - 1)];
+      const ay = j === 0 ? beforeWorld[1] : cur[3 * (j - 1) + 1];
+      const az = j === 0 ? beforeWorld[2] : cur[3 * (j - 1) + 2];
+      const dx = cur[b] - ax, dy = cur[b + 1] - ay, dz = cur[b + 2] - az;
+      const dist = Math.sqrt(dx * dx + dy * dy + dz * dz);
+      if (dist >= bendMin || dist === 0) continue;
+      const f = (dist - bendMin) / dist;
+      if (j <= 1) {
+        cur[b] = cur[b] - dx * f; cur[b + 1] = cur[b + 1] - dy * f; cur[b + 2] = cur[b + 2] - dz * f;
+      } else {
+        const a = 3 * (j - 1);
+        const hf = 0.5 * f;
+        cur[a] = ax + dx * hf; cur[a + 1] = ay + dy * hf; cur[a + 2] = az + dz * hf;
+        cur[b] = cur[b] - dx * hf; cur[b + 1] = cur[b + 1] - dy * hf; cur[b + 2] = cur[b + 2] - dz * hf;
+      }
+    }
   }
 
   function ropes(integrate) {
@@ -402,12 +488,13 @@ export function createMotion(data, lcg, { support = createFlatGround(), gravity 
       m.ropes.forEach((rope, r) => {
         for (let j = 0; j < rope.rest.length; j++) {
           anchorPoint(rope, j, v3, 0);
-          toWorldRoot(root, v3[0], v3[1], v3[2], nodes[r], 3 * j);
+          toWorldRoot(root, v3, 0, nodes[r], 3 * j);
           prevNodes[r][3 * j] = nodes[r][3 * j]; prevNodes[r][3 * j + 1] = nodes[r][3 * j + 1]; prevNodes[r][3 * j + 2] = nodes[r][3 * j + 2];
         }
       });
     }
-    gravity.at(tick * d.dt, grav);
+    // A constant provider (createGravity) was sampled once; any other is asked every tick.
+    if (gravity.constant !== true) gravity.at(tick * d.dt, grav);
     const substeps = c.ropeSubsteps, passes = c.ropePasses, keep = 1 - c.ropeDamping;
     const h = d.dt / substeps;
     const gx = grav[0] * h * h, gy = grav[1] * h * h, gz = grav[2] * h * h;
@@ -416,8 +503,13 @@ export function createMotion(data, lcg, { support = createFlatGround(), gravity 
       const cur = nodes[r], prev = prevNodes[r];
       const count = rope.rest.length;
       anchorPoint(rope, 0, anchorLocal, 0);
-      toWorldRoot(root, anchorLocal[0], anchorLocal[1], anchorLocal[2], anchorWorld, 0);
-      const seg = rope.segment;
+      toWorldRoot(root, anchorLocal, 0, anchorWorld, 0);
+      const seg = rope.segment, radius = rope.radius;
+      const bf = rope.before;
+      rotate(quats, 4 * rope.parent, bf, 0, v3, 0);
+      const bp = 3 * rope.parent;
+      v3[0] = v3[0] + trans[bp]; v3[1] = v3[1] + trans[bp + 1]; v3[2] = v3[2] + trans[bp + 2];
+      toWorldRoot(root, v3, 0, beforeWorld, 0);
       if (integrate) {
         for (let sub = 0; sub < substeps; sub++) {
           for (let k = 0; k < 3; k++) { cur[k] = anchorWorld[k]; prev[k] = anchorWorld[k]; }
@@ -443,31 +535,42 @@ export function createMotion(data, lcg, { support = createFlatGround(), gravity 
                 cur[b] = cur[b] - dx * hf; cur[b + 1] = cur[b + 1] - dy * hf; cur[b + 2] = cur[b + 2] - dz * hf;
               }
             }
+            bend(cur, count, rope);
+            if (m.ropeGround) {
+              for (let j = 1; j < count; j++) {
+                toLocal(frame, cur, 3 * j, w3, 0);
+                if (w3[1] < radius[j]) { w3[1] = radius[j]; toWorld(frame, w3, 0, cur, 3 * j); }
+              }
+            }
           }
         }
       }
-      for (let j = 0; j < count; j++) toLocalRoot(root, cur[3 * j], cur[3 * j + 1], cur[3 * j + 2], localNodes, 3 * j);
+      for (let j = 0; j < count; j++) toLocalRoot(root, cur, 3 * j, localNodes, 3 * j);
       const rest = rope.rest;
       // Segment frames by parallel transport down the chain (motion/simulate.py): each turns by the bend
       // from the one before, the first from its parent's, so the twist is continuous and well conditioned.
-      normalizeInto(rest[1][0] - rest[0][0], rest[1][1] - rest[0][1], rest[1][2] - rest[0][2], e1, 0);
-      rotate(quats, 4 * rope.parent, e1[0], e1[1], e1[2], e0, 0);
+      n3[0] = rest[1][0] - rest[0][0]; n3[1] = rest[1][1] - rest[0][1]; n3[2] = rest[1][2] - rest[0][2];
+      normalizeInto(n3, 0, e1, 0);
+      rotate(quats, 4 * rope.parent, e1, 0, e0, 0);
       let prevSlot = rope.parent;
       for (let j = 0; j < rope.slots.length; j++) {
         const slot = rope.slots[j];
         const a = rest[j];
         const o = 3 * j;
-        normalizeInto(localNodes[o + 3] - localNodes[o], localNodes[o + 4] - localNodes[o + 1], localNodes[o + 5] - localNodes[o + 2], e1, 0);
-        fromTo(e0[0], e0[1], e0[2], e1[0], e1[1], e1[2], q, 0);
+        n3[0] = localNodes[o + 3] - localNodes[o]; n3[1] = localNodes[o + 4] - localNodes[o + 1]; n3[2] = localNodes[o + 5] - localNodes[o + 2];
+        normalizeInto(n3, 0, e1, 0);
+        fromTo(e0, 0, e1, 0, q, 0);
         mul(q, 0, quats, 4 * prevSlot, quats, 4 * slot);
         prevSlot = slot;
         e0[0] = e1[0]; e0[1] = e1[1]; e0[2] = e1[2];
-        rotate(quats, 4 * slot, a[0], a[1], a[2], turned, 0);
+        rotate(quats, 4 * slot, a, 0, turned, 0);
         trans[3 * slot] = localNodes[o] - turned[0]; trans[3 * slot + 1] = localNodes[o + 1] - turned[1]; trans[3 * slot + 2] = localNodes[o + 2] - turned[2];
       }
       const s0 = rope.slots[0];
-      rotate(quats, 4 * s0, rest[0][0], rest[0][1], rest[0][2], turned, 0);
-      const err = Math.hypot(turned[0] + trans[3 * s0] - anchorLocal[0], turned[1] + trans[3 * s0 + 1] - anchorLocal[1], turned[2] + trans[3 * s0 + 2] - anchorLocal[2]);
+      rotate(quats, 4 * s0, rest[0], 0, turned, 0);
+      const ex = turned[0] + trans[3 * s0] - anchorLocal[0], ey = turned[1] + trans[3 * s0 + 1] - anchorLocal[1];
+      const ez = turned[2] + trans[3 * s0 + 2] - anchorLocal[2];
+      const err = Math.sqrt(ex * ex + ey * ey + ez * ez);
       gv[G.ropeAnchor] = Math.max(gv[G.ropeAnchor], err / m.bodyScale);
     }
   }
@@ -476,9 +579,11 @@ export function createMotion(data, lcg, { support = createFlatGround(), gravity 
 
   function reset() {
     const radius = m.pathRadius;
-    centre[0] = pos[0] - radius * pcos(theta0);
+    sc[2] = theta0;
+    sincos(sc, 2, sc, 0);
+    centre[0] = pos[0] - radius * sc[1];
     centre[1] = pos[1];
-    centre[2] = pos[2] - radius * psin(theta0);
+    centre[2] = pos[2] - radius * sc[0];
     tick = 0;
     planted.fill(1); plant.fill(0); swingFrom.fill(0); swingTo.fill(0); liftTick.fill(0);
     swim.fill(0);
@@ -527,6 +632,16 @@ export function createMotion(data, lcg, { support = createFlatGround(), gravity 
         outQuats[o] = x / n; outQuats[o + 1] = y / n; outQuats[o + 2] = z / n; outQuats[o + 3] = w / n;
         for (let k = 0; k < 3; k++) outTrans[3 * s + k] = prevTrans[3 * s + k] + (trans[3 * s + k] - prevTrans[3 * s + k]) * alpha;
       }
+    },
+    /** Each leg's plant point in world space at the current tick and whether it is planted: (x, y, z, planted)
+     * per leg into `out` (4 × legs numbers). A read accessor for markers and checks; it changes no state. */
+    feet(out) {
+      support.frame(tick * d.dt, frame2);
+      for (let i = 0; i < L; i++) {
+        toWorld(frame2, plant, 3 * i, out, 4 * i);
+        out[4 * i + 3] = planted[i];
+      }
+      return out;
     },
     /** Root, every slot's quaternion and translation, rope nodes (what parity compares); allocates. */
     stateVector() {

@@ -13,16 +13,21 @@ export const SWIMMER_CHANNELS = Object.freeze(['freeSurfacePoint', 'freeSurfaceN
 
 export function createGravity(vector = [0, -STANDARD_GRAVITY, 0]) {
   const v = Float64Array.from(vector);
-  return { at(time, out) { out[0] = v[0]; out[1] = v[1]; out[2] = v[2]; return out; } };
+  // constant: the core samples it once instead of every tick (no time passed per step).
+  return { constant: true, at(time, out) { out[0] = v[0]; out[1] = v[1]; out[2] = v[2]; return out; } };
 }
 
-export function toWorld(f, u, h, w, out, o) {
+/** Support-local (u, h, w) = v[vo..vo+2] → world, into out[o..o+2]. */
+export function toWorld(f, v, vo, out, o) {
+  const u = v[vo], h = v[vo + 1], w = v[vo + 2];
   out[o] = f[0] + u * f[3] + h * f[6] + w * f[9];
   out[o + 1] = f[1] + u * f[4] + h * f[7] + w * f[10];
   out[o + 2] = f[2] + u * f[5] + h * f[8] + w * f[11];
 }
 
-export function toLocal(f, px, py, pz, out, o) {
+/** World p[po..po+2] → support-local (u, h, w), into out[o..o+2]. */
+export function toLocal(f, p, po, out, o) {
+  const px = p[po], py = p[po + 1], pz = p[po + 2];
   const dx = px - f[0], dy = py - f[1], dz = pz - f[2];
   out[o] = dx * f[3] + dy * f[4] + dz * f[5];
   out[o + 1] = dx * f[6] + dy * f[7] + dz * f[8];
@@ -31,19 +36,22 @@ export function toLocal(f, px, py, pz, out, o) {
 
 /** The SupportSurfaceProvider surface every built-in shares: closest point, outward normal, point
  * velocity and acceleration, stable ids. Providers supply frame(), velocity() and acceleration(). */
-function support(name, supportId, frame, velocity, acceleration) {
+function support(name, supportId, frame, velocity, acceleration, isStatic = false) {
   const f = new Float64Array(12);
   const local = new Float64Array(3);
   return {
     name, supportId,
+    // static: the frame never moves, so the core samples it once instead of every tick.
+    static: isStatic,
     frame,
     velocity,
     acceleration,
     featureId() { return 0; },
     closestPoint(time, p, out) {
       frame(time, f);
-      toLocal(f, p[0], p[1], p[2], local, 0);
-      toWorld(f, local[0], 0, local[2], out, 0);
+      toLocal(f, p, 0, local, 0);
+      local[1] = 0;
+      toWorld(f, local, 0, out, 0);
       return out;
     },
     normal(time, p, out) {
@@ -59,7 +67,7 @@ const zero = (time, p, out) => { out[0] = 0; out[1] = 0; out[2] = 0; return out;
 export function createFlatGround() {
   return support('flat', 1, (time, out) => {
     out.fill(0); out[3] = 1; out[7] = 1; out[11] = 1; return out;
-  }, zero, zero);
+  }, zero, zero, true);
 }
 
 /** A plane through the origin rising along +z by `angle` radians (default 10°). */
@@ -67,7 +75,7 @@ export function createSlope(angle = 10 * (Math.PI / 180)) {
   const c = pcos(angle), s = psin(angle);
   return support('slope', 2, (time, out) => {
     out.fill(0); out[3] = 1; out[7] = c; out[8] = -s; out[10] = s; out[11] = c; return out;
-  }, zero, zero);
+  }, zero, zero, true);
 }
 
 /** The ground plane carried at constant velocity (m/s). */
@@ -123,7 +131,8 @@ export function createAnalyticWater({
       const gx = a1 * k1 * pcos(p1);
       const gz = a2 * k2 * pcos(p2);
       const inv = 1 / Math.sqrt(gx * gx + 1 + gz * gz);
-      for (const name of present) {
+      for (let i = 0; i < present.length; i++) {
+        const name = present[i];
         const v = out[name];
         if (name === 'freeSurfacePoint') { v[0] = x; v[1] = eta; v[2] = z; }
         else if (name === 'freeSurfaceNormal') { v[0] = -gx * inv; v[1] = inv; v[2] = -gz * inv; }

@@ -46,3 +46,22 @@ export function pcos(x) {
   if (q === 2) return -kcos(y);
   return ksin(y);
 }
+
+/** sin and cos of a[ao] into out[o], out[o + 1]: psin's and pcos's arithmetic (one shared reduction),
+ * with no double crossing a call, so the hot path boxes nothing (quat.js). */
+export function sincos(a, ao, out, o) {
+  const x = a[ao];
+  const n = Math.floor(x * INV_PIO2 + 0.5);
+  const y = (x - n * PIO2_1) - n * PIO2_1T;
+  const q = ((n % 4) + 4) % 4;
+  const z = y * y;
+  // ksin(y) and kcos(y), term by term
+  const v = z * y;
+  const rs = S2 + z * (S3 + z * (S4 + z * (S5 + z * S6)));
+  const sn = y + v * (S1 + z * rs);
+  const rc = z * (C1 + z * (C2 + z * (C3 + z * (C4 + z * (C5 + z * C6)))));
+  const hz = 0.5 * z;
+  const w = 1 - hz;
+  const cs = w + (((1 - w) - hz) + z * rc);
+  if (q === 0) { out[o] = sn; out[o + 1] = cs; } else if (q === 1) { out[o] = cs; out[o + 1] = -sn; } else if (q === 2) { out[o] = -sn; out[o + 1] = -cs; } else { out[o] = -cs; out[o + 1] = sn; }
+}

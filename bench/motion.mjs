@@ -1,0 +1,93 @@
+// The Node side of bench/motion.py: CPU cost and allocation of a creature package's locomotion core.
+//
+//   node --expose-gc bench/motion.mjs <package>/core/index.js '<json options>'
+//
+// Prints one JSON object: per-step cost (µs per creature per fixed step, median of rounds), steady-state
+// allocation (V8 heap growth and garbage collections over a run of steps, after a full collection), and,
+// for creatures with ropes, the rope cost against substeps × passes × segments. Bench code: it may use
+// wall clocks; the shipped core it measures may not.
+import { PerformanceObserver } from 'node:perf_hooks';
+import { pathToFileURL } from 'node:url';
+
+const [corePath, optionsText] = process.argv.slice(2);
+if (!corePath) throw new Error('usage: node --expose-gc bench/motion.mjs <package>/core/index.js [json options]');
+if (typeof globalThis.gc !== 'function') throw new Error('run node with --expose-gc');
+const options = {
+  bodies: 32, warm: 300, ticks: 300, rounds: 5, allocWarm: 20000, allocSteps: 5000, ropeConfigs: [[1, 2], [2, 4], [4, 8]],
+  only: null, ...JSON.parse(optionsText ?? '{}'),
+};
+const core = await import(pathToFileURL(corePath).href);
+const data = core.CREATURE;
+
+function bodies(motionData, count) {
+  const out = [];
+  for (let i = 0; i < count; i++) {
+    out.push(core.createMotion(motionData, data.lcg, { water: core.createAnalyticWater(), seed: i + 1, position: [i * 3 * data.bodyScale, 0, 0] }));
+  }
+  return out;
+}
+
+/** Median µs per creature per step over rounds of `ticks` steps of every body, after `warm` steps. */
+function stepCost(motionData, count = options.bodies) {
+  const list = bodies(motionData, count);
+  for (const m of list) m.stepTicks(options.warm);
+  const samples = [];
+  for (let r = 0; r < options.rounds; r++) {
+    const t0 = process.hrtime.bigint();
+    for (let k = 0; k < options.ticks; k++) for (let i = 0; i < list.length; i++) list[i].step();
+    samples.push(Number(process.hrtime.bigint() - t0) / 1000 / (options.ticks * list.length));
+  }
+  samples.sort((a, b) => a - b);
+  return { median: samples[Math.floor(samples.length / 2)], min: samples[0], max: samples.at(-1), samples };
+}
+
+/** `steps` steps of `m`: the measured loop, a function of its own so it is optimised (and its compiled
+ * code allocated) during the warm-up, not inside the measured window. */
+function run(m, steps) {
+  for (let k = 0; k < steps; k++) m.step();
+}
+
+/**
+ * Heap growth and collections over `allocSteps` steady-state steps of one body, after `allocWarm` steps
+ * through the same loop (V8 needs thousands of steps to settle its optimised code: until then unoptimised
+ * code boxes every double, and compiling allocates too) and a full collection.
+ */
+function allocation(motionData) {
+  const [m] = bodies(motionData, 1);
+  for (let k = 0; k < 4; k++) run(m, options.allocWarm / 4);
+  let collections = 0;
+  const observer = new PerformanceObserver((list) => { collections += list.getEntries().length; });
+  observer.observe({ entryTypes: ['gc'] });
+  globalThis.gc();
+  const before = process.memoryUsage().heapUsed;
+  run(m, options.allocSteps);
+  const after = process.memoryUsage().heapUsed;
+  return new Promise((resolve) => setImmediate(() => {
+    observer.disconnect();
+    resolve({ steps: options.allocSteps, heapGrowthBytes: after - before, bytesPerStep: (after - before) / options.allocSteps, collections });
+  }));
+}
+
+const motion = data.motion;
+const result = {
+  package: data.slug, type: motion.type, hz: motion.hz, slots: data.slotCount, legs: motion.legs.length,
+  ropes: motion.ropes.map((r) => ({ part: r.part, segments: r.slots.length })),
+  node: process.version,
+  allocation: await allocation(motion),
+};
+if (options.only !== 'allocation') result.step = stepCost(motion);
+if (motion.ropes.length && options.only !== 'allocation') {
+  const segments = motion.ropes.reduce((n, r) => n + r.slots.length, 0);
+  const without = stepCost({ ...motion, ropes: [] });
+  const configs = options.ropeConfigs.map(([substeps, passes]) => {
+    const variant = { ...motion, constants: { ...motion.constants, ropeSubsteps: substeps, ropePasses: passes } };
+    const cost = stepCost(variant);
+    return { substeps, passes, segments, work: substeps * passes * segments, stepUs: cost.median, ropeUs: cost.median - without.median };
+  });
+  // Least squares of rope µs against substeps·passes·segments: the cost per unit of rope work.
+  const n = configs.length;
+  const mx = configs.reduce((a, c) => a + c.work, 0) / n, my = configs.reduce((a, c) => a + c.ropeUs, 0) / n;
+  const slope = configs.reduce((a, c) => a + (c.work - mx) * (c.ropeUs - my), 0) / configs.reduce((a, c) => a + (c.work - mx) ** 2, 0);
+  result.rope = { withoutRopesUs: without.median, configs, usPerUnit: slope, interceptUs: my - slope * mx };
+}
+console.log(JSON.stringify(result));

@@ -1,0 +1,80 @@
+"""Pose pages and the seeded LCG: how one instance's pose reaches the GPU, and where its variation comes from.
+
+The pose of an instance is whatever the locomotion core (motion/simulate.py, core/motion/motion.js) left in
+its per-slot quaternions and translations, ``x' = R(q_s)·x + t_s`` in creature-local space, plus the root
+(position, heading cos/sin, squash) that the material applies once. The JS core writes them as float32
+rows (core/pose.js writePoseRows, the same arithmetic in the same order as ``pose_rows``):
+
+- per slot, POSE_ROWS vec4: (a, ra), (b, rb), (k, rgb), quaternion xyzw, (t, roundCone);
+- after the slots, two root rows: (x, y, z, alive), (cos yaw, sin yaw, squash, 0).
+
+The LCG is integer arithmetic, identical in Python and JS, so the reference reproduces any spawned
+instance from its seed.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from typing import Final
+
+import numpy as np
+import numpy.typing as npt
+
+from ..field import layout as col
+from ..field.primitives import slot_uses_round_cone
+from ..motion import quat as vq
+from ..rig import CompiledRig
+from ..surface.deform import Pose, quaternion_to_matrix
+
+F64 = npt.NDArray[np.float64]
+
+#: Rows of four floats per slot in a pose page: (a, ra), (b, rb), (k, rgb), quaternion xyzw, (t, roundCone).
+POSE_ROWS: Final = 5
+#: Numerical Recipes LCG, modulo 2³².
+LCG_A: Final = 1664525
+LCG_C: Final = 1013904223
+
+
+def lcg_next(state: int) -> int:
+    return (LCG_A * state + LCG_C) % (1 << 32)
+
+
+def instance_yaw(seed: int) -> float:
+    """Yaw in [0, 2π) of an instance spawned from ``seed``: the second LCG draw (the first is reserved)."""
+    second = lcg_next(lcg_next(seed % (1 << 32)))
+    return second / 4294967296.0 * 2.0 * math.pi
+
+
+def as_pose(quats: Sequence[Sequence[float]], trans: Sequence[Sequence[float]]) -> Pose:
+    """Per-slot quaternions (xyzw) and translations as a deform.Pose (what the numpy skinning consumes)."""
+    q = np.asarray(quats, dtype=np.float64)
+    wxyz = np.concatenate([q[:, 3:4], q[:, :3]], axis=1)
+    return Pose(quaternion_to_matrix(wxyz), np.asarray(trans, dtype=np.float64))
+
+
+def pose_rows(
+    rig: CompiledRig, quats: Sequence[Sequence[float]], trans: Sequence[Sequence[float]]
+) -> npt.NDArray[np.float32]:
+    """(S, POSE_ROWS, 4) float32 rows of one instance's pose page entry, as the JS core writes them."""
+    slots = rig.slots
+    t = np.asarray(trans, dtype=np.float64)
+    rows = np.zeros((rig.slot_count, POSE_ROWS, 4))
+    for s in range(rig.slot_count):
+        rows[s, 0, :3] = np.array(vq.rotate(list(quats[s]), list(slots[s, col.A]))) + t[s]
+        rows[s, 1, :3] = np.array(vq.rotate(list(quats[s]), list(slots[s, col.B]))) + t[s]
+    rows[:, 0, 3] = slots[:, col.RA]
+    rows[:, 1, 3] = slots[:, col.RB]
+    rows[:, 2, 0] = slots[:, col.K]
+    rows[:, 2, 1:4] = slots[:, col.RGB]
+    rows[:, 3] = np.asarray(quats, dtype=np.float64)
+    rows[:, 4, :3] = t
+    rows[:, 4, 3] = slot_uses_round_cone(slots)
+    return rows.astype(np.float32)
+
+
+def root_rows(root: Sequence[float], alive: bool = True) -> npt.NDArray[np.float32]:
+    """(2, 4) float32 root rows: (x, y, z, alive), (cos yaw, sin yaw, squash, 0)."""
+    return np.array(
+        [[root[0], root[1], root[2], float(alive)], [root[3], root[4], root[5], 0.0]], dtype=np.float32
+    )
