@@ -8,10 +8,12 @@ measures, in this run:
 * **step cost**: ``--bodies`` creatures (seeds 1..N, flat ground, the analytic water for a swimmer) after
   ``--warm`` steps each; ``--rounds`` rounds of ``--ticks`` steps of every body; the median µs per
   creature per step (min and max beside it);
-* **allocation**: one creature after the warm-up and a full collection (``--expose-gc``), then
-  ``--alloc-steps`` steps: V8 heap growth (``heapUsed``) and garbage collections seen by a ``gc``
-  PerformanceObserver. Zero bytes per step and no collection is the contract (the shipped core keeps its
-  state and scratch in typed arrays allocated by ``createMotion``);
+* **allocation**: one creature after 20000 warm-up steps, then three windows of ``--alloc-steps`` steps,
+  each after a full collection (``--expose-gc``): V8 heap growth (``heapUsed``) and the garbage
+  collections a ``gc`` PerformanceObserver saw start inside the window. The smallest window is reported
+  (a window can catch a late background compilation on a loaded machine), every window beside it. Zero
+  bytes per step and no collection is the contract; bytes per step understate the rate when a collection
+  ran in the window;
 * **ropes** (creatures with ropes): the step cost with the ropes removed and at several (substeps, passes),
   and the least-squares µs per unit of rope work (substeps · passes · segments).
 

@@ -110,6 +110,13 @@ def build_plan(
         "debugModes": list(DEBUG_MODES),
         "deformStride": DEFORM_STRIDE,
     }
+    swims = motion["type"] == "swimmer"
+    # The README's usage snippet: a swimmer needs a water provider (the template only prints these).
+    usage = {
+        "imports": "createCreaturePopulation, createAnalyticWater" if swims else "createCreaturePopulation",
+        "options": "{ capacity: 64, water: createAnalyticWater() }" if swims else "{ capacity: 64 }",
+        "water": " and `water` (required: this creature swims)" if swims else "",
+    }
     corrected = int(np.count_nonzero(skin[:, 1] > 0))
     plan: dict[str, Any] = {
         "name": spec.name,
@@ -117,6 +124,7 @@ def build_plan(
         "version": __version__,
         "specSha256": spec_sha256,
         "runtime": runtime,
+        "usage": usage,
         "signatures": dict(surface.signatures),
         "tier": surface.tier,
         "gates": [g.as_dict() for g in surface.gates],

@@ -36,6 +36,7 @@ from scipy import ndimage
 
 from ..creature import reference as cref
 from ..creature.pose import as_pose, pose_rows, root_rows
+from ..motion.simulate import Motion
 from ..surface.deform import posed_slots
 from .browser import launch_lab_page
 from .png import write_png
@@ -144,9 +145,10 @@ def _hash_gate(page: Page, report: ParityReport) -> None:
     report.measurements["stateHash"] = {"tick": PARITY_TICK, "stepped": stepped, "seeked": seeked}
 
 
-def _pose_and_field_gates(page: Page, ref: cref.PackageReference, report: ParityReport) -> None:
+def _pose_and_field_gates(
+    page: Page, ref: cref.PackageReference, motion: Motion, report: ParityReport
+) -> None:
     scale = ref.rig.body_scale
-    motion = cref.instance_motion(ref, LAB_SEED, PARITY_TICK, LAB_POSITION)
     gpu_rows = np.asarray(page.evaluate("() => window.__lab.readPose(0)"), dtype=np.float32)
     rows = np.concatenate(
         [pose_rows(ref.rig, motion.quats, motion.trans).reshape(-1), root_rows(motion.root).reshape(-1)]
@@ -192,11 +194,10 @@ def _pose_and_field_gates(page: Page, ref: cref.PackageReference, report: Parity
     }
 
 
-def _motion_gates(page: Page, ref: cref.PackageReference, report: ParityReport) -> None:
+def _motion_gates(page: Page, ref: cref.PackageReference, motion: Motion, report: ParityReport) -> None:
     """The locomotion core as it runs in the page (V8 in Chromium) against the Python reference, and the
     planted feet as the GPU pose buffer draws them against their plant points (the lab's markers)."""
     scale = ref.rig.body_scale
-    motion = cref.instance_motion(ref, LAB_SEED, PARITY_TICK, LAB_POSITION)
     got = page.evaluate("() => window.__lab.motionState(0)")
     expected = np.asarray(motion.state_vector())
     state = np.asarray(got["state"], dtype=np.float64)
@@ -219,9 +220,8 @@ def _motion_gates(page: Page, ref: cref.PackageReference, report: ParityReport) 
     report.measurements["feet"] = {"legs": len(feet), "planted": len(planted), "drift": feet}
 
 
-def _skin_gates(page: Page, ref: cref.PackageReference, report: ParityReport) -> None:
+def _skin_gates(page: Page, ref: cref.PackageReference, motion: Motion, report: ParityReport) -> None:
     scale = ref.rig.body_scale
-    motion = cref.instance_motion(ref, LAB_SEED, PARITY_TICK, LAB_POSITION)
     pose = as_pose(motion.quats, motion.trans)
     table = posed_slots(ref.rig.slots, pose)
     got = page.evaluate("() => window.__lab.readSkinned(0)")
@@ -332,6 +332,8 @@ def run_creature_parity(
     PNGs (front.png always, debug views on request) into it. GPU validation errors are always gated."""
     package = package.resolve()
     ref = cref.load_reference(package)
+    # Instance 0 as the lab spawns it, at the parity tick: what every pose, field and skin gate compares.
+    motion = cref.instance_motion(ref, LAB_SEED, PARITY_TICK, LAB_POSITION)
     report = ParityReport(package=package.name)
     (package / "parity").mkdir(exist_ok=True)
     seconds: dict[str, float] = {}
@@ -350,9 +352,9 @@ def run_creature_parity(
         phase("population", lambda: _counter_gates(page, report))
         phase("hash", lambda: _hash_gate(page, report))
         page.evaluate(f"() => window.__lab.seekTick({PARITY_TICK})")
-        phase("field", lambda: _pose_and_field_gates(page, ref, report))
-        phase("motion", lambda: _motion_gates(page, ref, report))
-        phase("skin", lambda: _skin_gates(page, ref, report))
+        phase("field", lambda: _pose_and_field_gates(page, ref, motion, report))
+        phase("motion", lambda: _motion_gates(page, ref, motion, report))
+        phase("skin", lambda: _skin_gates(page, ref, motion, report))
         phase("shadow", lambda: _shadow_gate(page, package, report))
         t = time.perf_counter()
         _pictures(page, package, debug_pictures)

@@ -59,8 +59,8 @@ def length(a: Vec) -> float:
 
 
 def norm3(x: float, y: float, z: float) -> float:
-    """|(x, y, z)| as sqrt((x² + y²) + z²): the JS core's norm3 (math.hypot and Math.hypot round differently,
-    and Math.hypot is a builtin call that boxes its arguments)."""
+    """|(x, y, z)| as sqrt((x² + y²) + z²), which the JS core writes inline (math.hypot and Math.hypot round
+    differently, and a JS call returning a double boxes it unless V8 inlines the call)."""
     return math.sqrt(x * x + y * y + z * z)
 
 

@@ -5,7 +5,7 @@
 // A support frame is 12 numbers: origin, tangent ex, outward normal ny, tangent ez; support-local
 // (u, h, w) maps to origin + u·ex + h·ny + w·ez.
 
-import { pcos, psin } from './trig.js';
+import { sincos } from './trig.js';
 
 export const STANDARD_GRAVITY = 9.80665;
 export const SWIMMER_CHANNELS = Object.freeze(['freeSurfacePoint', 'freeSurfaceNormal', 'geometricNormalVelocityMps']);
@@ -71,7 +71,9 @@ export function createFlatGround() {
 
 /** A plane through the origin rising along +z by `angle` radians (default 10°). */
 export function createSlope(angle = 10 * (Math.PI / 180)) {
-  const c = pcos(angle), s = psin(angle);
+  const t = Float64Array.of(0, 0, angle);
+  sincos(t, 2, t, 0);
+  const c = t[1], s = t[0];
   return support('slope', 2, (time, out) => {
     out.fill(0); out[3] = 1; out[7] = c; out[8] = -s; out[10] = s; out[11] = c; return out;
   }, zero, zero, true);
@@ -90,9 +92,11 @@ export function createTranslatingPlatform(velocity = [0.3, 0, 0.1]) {
 /** The ground plane turning about the vertical through `centre` at `omega` rad/s. */
 export function createRotatingPlatform(centre = [0.5, 0, -0.4], omega = 0.35) {
   const c0 = Float64Array.from(centre);
+  const t = new Float64Array(3); // sin, cos, angle
   return support('rotating', 4, (time, out) => {
-    const a = omega * time;
-    const c = pcos(a), s = psin(a);
+    t[2] = omega * time;
+    sincos(t, 2, t, 0);
+    const c = t[1], s = t[0];
     out[0] = c0[0]; out[1] = c0[1]; out[2] = c0[2];
     out[3] = c; out[4] = 0; out[5] = -s; out[6] = 0; out[7] = 1; out[8] = 0; out[9] = s; out[10] = 0; out[11] = c;
     return out;
@@ -117,18 +121,21 @@ export function createAnalyticWater({
 } = {}) {
   const present = Object.freeze(channels.filter((c) => WAVE_CHANNELS.includes(c)));
   const [[a1, k1, w1], [a2, k2, w2]] = waves;
+  const t1 = new Float64Array(3), t2 = new Float64Array(3); // sin, cos, phase of each wave
   return {
     channels: present,
     createSample() {
       return { freeSurfacePoint: new Float64Array(3), freeSurfaceNormal: new Float64Array(3), geometricNormalVelocityMps: new Float64Array(1), waterColumnDepthMeters: new Float64Array(1) };
     },
     sample(x, z, time, out) {
-      const p1 = k1 * x - w1 * time;
-      const p2 = k2 * z - w2 * time + 0.7;
-      const eta = level + a1 * psin(p1) + a2 * psin(p2);
-      const detaDt = -a1 * w1 * pcos(p1) - a2 * w2 * pcos(p2);
-      const gx = a1 * k1 * pcos(p1);
-      const gz = a2 * k2 * pcos(p2);
+      t1[2] = k1 * x - w1 * time;
+      t2[2] = k2 * z - w2 * time + 0.7;
+      sincos(t1, 2, t1, 0);
+      sincos(t2, 2, t2, 0);
+      const eta = level + a1 * t1[0] + a2 * t2[0];
+      const detaDt = -a1 * w1 * t1[1] - a2 * w2 * t2[1];
+      const gx = a1 * k1 * t1[1];
+      const gz = a2 * k2 * t2[1];
       const inv = 1 / Math.sqrt(gx * gx + 1 + gz * gz);
       for (let i = 0; i < present.length; i++) {
         const name = present[i];

@@ -84,6 +84,8 @@ export interface Motion {
 }
 
 export class TierRefusedError extends Error {}
+/** Throws TierRefusedError unless a swimmer (`kind`) has water representing every channel it reads. */
+export function assertWaterFor(kind: string, water: WaterSurfaceProvider | null, who?: string): void;
 export function createMotion(data: unknown, lcg: { a: number; c: number }, options?: {
   support?: SupportSurfaceProvider; gravity?: GravityProvider; water?: WaterSurfaceProvider | null; seed?: number;
   position?: [number, number, number];

@@ -12,5 +12,5 @@ export {
   STANDARD_GRAVITY, SWIMMER_CHANNELS, builtinSupports, createAnalyticWater, createFlatGround, createGravity,
   createRotatingPlatform, createSlope, createTranslatingPlatform, toLocal, toWorld,
 } from './motion/providers.js';
-export { TierRefusedError, createMotion } from './motion/motion.js';
+export { TierRefusedError, assertWaterFor, createMotion } from './motion/motion.js';
 export { derive, ticksFromSeconds } from './motion/derived.js';

@@ -11,8 +11,8 @@ import { CREATURE } from '../core/data.js';
 import { parseGlb } from '../core/glb.js';
 import { hashBytes } from '../core/hash.js';
 import { createDriver } from '../core/motion/driver.js';
-import { TierRefusedError, createMotion } from '../core/motion/motion.js';
-import { SWIMMER_CHANNELS, createFlatGround, createGravity } from '../core/motion/providers.js';
+import { assertWaterFor, createMotion } from '../core/motion/motion.js';
+import { createFlatGround, createGravity } from '../core/motion/providers.js';
 import { rootBounds, writePoseRows, writeRootRows } from '../core/pose.js';
 import { bodyFunctions, layoutOf } from './body.js';
 import {
@@ -82,11 +82,7 @@ export async function createCreaturePopulation(renderer, options = {}) {
   const support = options.support ?? createFlatGround();
   const gravity = options.gravity ?? createGravity();
   const water = options.water ?? null;
-  if (data.motion.type === 'swimmer') {
-    if (!water) throw new TierRefusedError(`${data.slug}: a swimmer needs options.water (a WaterSurfaceProvider, e.g. createAnalyticWater())`);
-    const missing = SWIMMER_CHANNELS.filter((c) => !water.channels.includes(c));
-    if (missing.length) throw new TierRefusedError(`${data.slug}: options.water does not represent ${missing.join(', ')}`);
-  }
+  assertWaterFor(data.motion.type, water, `${data.slug}: options.water`);
   const tier = options.tier ?? data.tier;
   if (tier !== data.tier) throw new Error(`tier: this package was built for tier ${data.tier} (got ${tier}); rebuild with --tier ${tier}`);
   const surface = await loadSurface(options.surfaceUrl ?? new URL('../assets/surface.glb', import.meta.url).href);

@@ -25,18 +25,19 @@ const G = Object.freeze(Object.fromEntries(GATE_NAMES.map((name, i) => [name, i]
 
 export class TierRefusedError extends Error {}
 
-/** |(x, y, z)| as sqrt((x² + y²) + z²), the reference's quat.norm3 (not Math.hypot: a builtin call that
- * boxes its arguments, and whose rounding differs from Python's math.hypot). */
-const norm3 = (x, y, z) => Math.sqrt(x * x + y * y + z * z);
+/** Throws TierRefusedError unless a swimmer has a water provider representing every channel it reads
+ * (absent channels are absent, never zero); `who` names the caller in the message. */
+export function assertWaterFor(kind, water, who = kind) {
+  if (kind !== 'swimmer') return;
+  if (!water) throw new TierRefusedError(`${who}: no WaterSurfaceProvider was injected`);
+  const missing = SWIMMER_CHANNELS.filter((c) => !water.channels.includes(c));
+  if (missing.length) throw new TierRefusedError(`${who}: the water provider does not represent ${missing.join(', ')}`);
+}
 
 export function createMotion(data, lcg, { support = createFlatGround(), gravity = createGravity(), water = null, seed = 0, position = [0, 0, 0] } = {}) {
   const m = data;
   const kind = m.type;
-  if (kind === 'swimmer') {
-    if (!water) throw new TierRefusedError('swimmer: no WaterSurfaceProvider was injected');
-    const missing = SWIMMER_CHANNELS.filter((c) => !water.channels.includes(c));
-    if (missing.length) throw new TierRefusedError(`swimmer: the water provider does not represent ${missing.join(', ')}`);
-  }
+  assertWaterFor(kind, water);
   const gravity0 = gravity.at(0, new Float64Array(3));
   const d = derive(m, gravity0);
   const yaw = instanceYaw(seed, lcg);
@@ -385,8 +386,12 @@ export function createMotion(data, lcg, { support = createFlatGround(), gravity 
     trans[3 * lo] = kx - turned[0]; trans[3 * lo + 1] = ky - turned[1]; trans[3 * lo + 2] = kz - turned[2];
     ik[0] = kx; ik[1] = ky; ik[2] = kz; ik[3] = fx; ik[4] = fy; ik[5] = fz;
     ik[6] = reach !== dist ? 1 : 0;
-    const thigh = norm3(kx - hip[0], ky - hip[1], kz - hip[2]);
-    const shin = norm3(fx - kx, fy - ky, fz - kz);
+    // Lengths as quat.norm3 in Python, sqrt((x² + y²) + z²), written inline: a call returning a double that
+    // V8 does not inline boxes it.
+    const tx = kx - hip[0], ty = ky - hip[1], tz = kz - hip[2];
+    const sx = fx - kx, sy = fy - ky, sz = fz - kz;
+    const thigh = Math.sqrt(tx * tx + ty * ty + tz * tz);
+    const shin = Math.sqrt(sx * sx + sy * sy + sz * sz);
     ik[7] = Math.max(Math.abs(thigh - a), Math.abs(shin - b)) / (a + b);
   }
 
@@ -436,13 +441,15 @@ export function createMotion(data, lcg, { support = createFlatGround(), gravity 
       rotate(quats, 4 * leg.lower, leg.foot, 0, v3, 0);
       const lo = 3 * leg.lower;
       const drawnX = v3[0] + trans[lo], drawnY = v3[1] + trans[lo + 1], drawnZ = v3[2] + trans[lo + 2];
-      gv[G.drawnFoot] = Math.max(gv[G.drawnFoot], norm3(drawnX - ik[3], drawnY - ik[4], drawnZ - ik[5]) / span);
+      const ex = drawnX - ik[3], ey = drawnY - ik[4], ez = drawnZ - ik[5];
+      gv[G.drawnFoot] = Math.max(gv[G.drawnFoot], Math.sqrt(ex * ex + ey * ey + ez * ez) / span);
       if (ik[6]) gv[G.clampedTicks] += 1;
       else if (planted[i]) {
         n3[0] = drawnX; n3[1] = drawnY; n3[2] = drawnZ;
         toWorldRoot(root, n3, 0, v3, 0);
         toLocal(frame, v3, 0, w3, 0);
-        gv[G.plantDrift] = Math.max(gv[G.plantDrift], norm3(w3[0] - plant[o], w3[1] - plant[o + 1], w3[2] - plant[o + 2]) / span);
+        const px = w3[0] - plant[o], py = w3[1] - plant[o + 1], pz = w3[2] - plant[o + 2];
+        gv[G.plantDrift] = Math.max(gv[G.plantDrift], Math.sqrt(px * px + py * py + pz * pz) / span);
         gv[G.plantedSamples] += 1;
       }
     }
