@@ -23,9 +23,11 @@ import pytest
 from conftest import EXAMPLES, REPO, node, run_cli, run_node_tests
 from creaturegen import __version__, cli
 from creaturegen.creature import pose as pose_module
+from creaturegen.creature.genome import draw_genome, genetics_data, genome_colours, slot_lab
 from creaturegen.emit.lint import Finding, lint_package, lint_sources, shipped_sources
 from creaturegen.emit.render import to_json
 from creaturegen.emit.writer import header_text
+from creaturegen.field import layout as col
 from creaturegen.field.primitives import slot_uses_round_cone
 from creaturegen.motion.providers import AnalyticWater
 from creaturegen.motion.rig import build_motion
@@ -408,6 +410,8 @@ def python_reference(spec_path: Path) -> dict[str, Any]:
     assert isinstance(spec, CharacterSpec)
     rig = compile_rig(spec)
     data = build_motion(spec, rig, build_skeleton(spec, rig))
+    genetics = genetics_data(spec.genetics.hue, spec.genetics.chroma, spec.genetics.lightness)
+    lab = slot_lab(rig.slots[:, col.RGB])
     lcg = []
     for seed in SEEDS:
         state, draws = seed % (1 << 32), []
@@ -418,13 +422,14 @@ def python_reference(spec_path: Path) -> dict[str, Any]:
     cases = []
     for seed in POSED_SEEDS:
         motion = Motion(data, water=AnalyticWater(), seed=seed)
+        colours = genome_colours(genetics, lab, draw_genome(seed))
         frames = []
         for tick in range(TICKS + 1):
             if tick:
                 motion.step()
             rows = np.concatenate(
                 [
-                    pose_module.pose_rows(rig, motion.quats, motion.trans).ravel(),
+                    pose_module.pose_rows(rig, motion.quats, motion.trans, colours).ravel(),
                     pose_module.root_rows(motion.root).ravel(),
                 ]
             )
@@ -438,7 +443,10 @@ def python_reference(spec_path: Path) -> dict[str, Any]:
             "roundCone": [int(x) for x in slot_uses_round_cone(rig.slots)],
         },
         "lcg": lcg,
-        "instances": [{"seed": seed, "yaw": pose_module.instance_yaw(seed)} for seed in SEEDS],
+        "instances": [
+            {"seed": seed, "mixed": pose_module.mix_seed(seed), "yaw": pose_module.instance_yaw(seed)}
+            for seed in SEEDS
+        ],
         "cases": cases,
         "frameCount": sum(len(c["frames"]) for c in cases),
     }

@@ -18,6 +18,7 @@ from typing import Any
 import pytest
 
 from conftest import CREATURE_EXAMPLES, EXAMPLES, REPO, build_example, node, run_node_tests
+from creaturegen.creature.genome import MAX_GAIT_GENES, Genome
 from creaturegen.motion.parity import motion_reference
 from creaturegen.motion.providers import (
     SWIMMER_CHANNELS,
@@ -29,7 +30,7 @@ from creaturegen.motion.providers import (
     to_world,
 )
 from creaturegen.motion.rig import WALKERS, build_motion
-from creaturegen.motion.simulate import Motion, TierRefusedError
+from creaturegen.motion.simulate import Gates, Motion, TierRefusedError
 from creaturegen.rig import compile_rig
 from creaturegen.spec.gate import load_spec
 from creaturegen.surface.skeleton import build_skeleton
@@ -50,35 +51,58 @@ def run(data: dict[str, Any], support: str, ticks: int = TICKS) -> Motion:
     return motion
 
 
+def assert_gates(where: str, g: Gates, data: dict[str, Any], ticks: int) -> None:
+    """Every locomotion gate of one run (``ticks`` fixed steps); prints the worst values."""
+    kind = data["type"]
+    print(
+        f"{where}: drift {g.plant_drift:.2e} ik {g.ik_residual:.2e} drawn {g.drawn_foot:.2e} "
+        f"clamped {g.clamped_ticks} steps {g.steps} rope {g.rope_anchor:.2e} swim {g.swim_tracking:.4f}m "
+        f"apex {g.apex_error:.2e} m squash@apex {g.apex_squash!r} both-swing {g.both_swing_ticks}"
+    )
+    assert g.plant_drift <= 1e-9, f"{where}: planted-foot drift {g.plant_drift:.3g} x leg length"
+    assert g.ik_residual <= 1e-12, f"{where}: IK length residual {g.ik_residual:.3g}"
+    assert g.drawn_foot <= 1e-9, f"{where}: drawn foot vs IK foot {g.drawn_foot:.3g}"
+    assert g.rope_anchor <= 1e-12, f"{where}: rope anchor error {g.rope_anchor:.3g} x L"
+    if kind in WALKERS:
+        assert g.steps > 0, f"{where}: no foot ever stepped"
+        assert g.planted_samples > 0
+        assert g.clamped_ticks <= 0.01 * len(data["legs"]) * ticks, f"{where}: {g.clamped_ticks} clamped"
+    if kind == "biped":
+        assert g.both_swing_ticks == 0, f"{where}: both feet in swing on {g.both_swing_ticks} ticks"
+    if kind == "hopper":
+        assert g.apex_error <= 1e-9, f"{where}: hop apex height error {g.apex_error:.3g} m"
+        assert g.apex_squash == 1.0, f"{where}: squash at the apex tick is {g.apex_squash!r}"
+        assert g.squash_det <= 4e-16, f"{where}: squash determinant off by {g.squash_det:.3g}"
+    if kind == "swimmer":
+        assert 0.0 < g.swim_tracking < 0.09, f"{where}: swim tracking {g.swim_tracking:.3g} m after 2 s"
+
+
 @pytest.mark.parametrize("name", EVERY_EXAMPLE)
 def test_gates_on_every_support(name: str) -> None:
     """Also prints each support's worst values: `pytest tests/test_motion.py -k gates -s` shows them."""
     data = motion_data(name)
-    kind = data["type"]
     for support in builtin_supports():
-        g = run(data, support).gates
-        print(
-            f"{name} {support}: drift {g.plant_drift:.2e} ik {g.ik_residual:.2e} drawn {g.drawn_foot:.2e} "
-            f"clamped {g.clamped_ticks} steps {g.steps} rope {g.rope_anchor:.2e} swim {g.swim_tracking:.4f}m "
-            f"apex {g.apex_error:.2e} m squash@apex {g.apex_squash!r} both-swing {g.both_swing_ticks}"
-        )
-        where = f"{name} on {support}"
-        assert g.plant_drift <= 1e-9, f"{where}: planted-foot drift {g.plant_drift:.3g} x leg length"
-        assert g.ik_residual <= 1e-12, f"{where}: IK length residual {g.ik_residual:.3g}"
-        assert g.drawn_foot <= 1e-9, f"{where}: drawn foot vs IK foot {g.drawn_foot:.3g}"
-        assert g.rope_anchor <= 1e-12, f"{where}: rope anchor error {g.rope_anchor:.3g} x L"
-        if kind in WALKERS:
-            assert g.steps > 0, f"{where}: no foot ever stepped"
-            assert g.planted_samples > 0
-            assert g.clamped_ticks <= 0.01 * len(data["legs"]) * TICKS, f"{where}: {g.clamped_ticks} clamped"
-        if kind == "biped":
-            assert g.both_swing_ticks == 0, f"{where}: both feet in swing on {g.both_swing_ticks} ticks"
-        if kind == "hopper":
-            assert g.apex_error <= 1e-9, f"{where}: hop apex height error {g.apex_error:.3g} m"
-            assert g.apex_squash == 1.0, f"{where}: squash at the apex tick is {g.apex_squash!r}"
-            assert g.squash_det <= 4e-16, f"{where}: squash determinant off by {g.squash_det:.3g}"
-        if kind == "swimmer":
-            assert 0.0 < g.swim_tracking < 0.09, f"{where}: swim tracking {g.swim_tracking:.3g} m after 2 s"
+        assert_gates(f"{name} on {support}", run(data, support).gates, data, TICKS)
+
+
+CORNER_TICKS = 600
+
+
+@pytest.mark.parametrize("name", EVERY_EXAMPLE)
+def test_gates_hold_at_the_corners_of_the_gait_gene_box(name: str) -> None:
+    """Every individual a spawn can draw moves within the gates: each gait gene at -1 and at +1 (the bounds
+    of the box every genome lies in), on flat ground. Scaling speed alone, or step length alone, failed
+    here (a foot lagging past its reach before its window opened); the pace gene scales them together."""
+    data = motion_data(name)
+    count = len(data["genes"]["fields"])
+    assert data["genes"]["jitter"] > 0.0
+    for signs in itertools.product((-1.0, 1.0), repeat=count):
+        genome = Genome(0.0, 0.0, 0.0, (*signs, *[0.0] * (MAX_GAIT_GENES - count)))
+        motion = Motion(data, water=AnalyticWater(), genome=genome)
+        fields = [f for group in data["genes"]["fields"] for f in group]
+        assert any(motion.data[f] != data[f] for f in fields), f"{name}: genes {signs} changed nothing"
+        motion.step_ticks(CORNER_TICKS)
+        assert_gates(f"{name} genes {signs}", motion.gates, motion.data, CORNER_TICKS)
 
 
 @pytest.mark.parametrize("support", ["translating", "rotating", "slope"])
@@ -98,10 +122,12 @@ def test_support_velocity_and_acceleration_describe_the_moving_frame(support: st
 
 def test_hop_air_time_is_physical_and_quantised() -> None:
     data = motion_data("reference/hopper.json")
-    d = Motion(data).d
+    motion = Motion(data)
+    d = motion.d
     assert d.air == 2 * d.half_air, "the apex is sampled exactly at a tick"
     air_s = d.air * d.dt
-    ideal = 2.0 * (2.0 * data["hopHeight"] / d.g) ** 0.5
+    # The individual's hop height (its gait gene scaled the authored one).
+    ideal = 2.0 * (2.0 * motion.data["hopHeight"] / d.g) ** 0.5
     assert abs(air_s - ideal) <= d.dt, (air_s, ideal)
     assert abs(d.apex - 0.5 * d.g * (d.half_air * d.dt) ** 2) < 1e-15
 

@@ -211,12 +211,44 @@ async function main() {
       cam.updateMatrixWorld();
       return { view, width, height, rgba: toBase64(await renderTo(cam, width, height)) };
     }
+    if (view === 'grid') return captureGrid();
     if (view === 'top') {
       const cam = sun.shadow.camera.clone();
       cam.position.copy(sun.position); cam.lookAt(sun.target.position); cam.updateMatrixWorld();
       return { view, width: 128, height: 128, rgba: toBase64(await renderTo(cam, 128, 128)) };
     }
     throw new Error(`capturePixels: view is front, portrait or top (got ${view})`);
+  }
+
+  // The whole population from above at three-quarters (the genetics grid): the camera frames the union of
+  // every live body's posed bounds and the shadow camera covers it, for this capture only.
+  const gridBox = new THREE.Box3();
+  const gridPoint = new THREE.Vector3();
+  async function captureGrid(w = 480, h = 320) {
+    gridBox.makeEmpty();
+    for (let i = 0; i < pop.capacity; i++) {
+      const info = pop.instance(i);
+      if (!info.alive) continue;
+      const b = info.bounds;
+      gridBox.expandByPoint(gridPoint.set(b[0], b[1], b[2]));
+      gridBox.expandByPoint(gridPoint.set(b[3], b[4], b[5]));
+    }
+    const centre = gridBox.getCenter(new THREE.Vector3());
+    const radius = 0.5 * gridBox.getSize(new THREE.Vector3()).length();
+    const cam = new THREE.PerspectiveCamera(30, w / h, 0.01 * radius, 20 * radius);
+    // The grid is flat: framing its bounding sphere leaves most of the picture empty.
+    const distance = 0.72 * radius / Math.sin(THREE.MathUtils.degToRad(15));
+    cam.position.copy(centre).add(new THREE.Vector3(0, 0.75, 1).normalize().multiplyScalar(distance));
+    cam.lookAt(centre);
+    cam.updateMatrixWorld();
+    sun.position.set(centre.x, centre.y + 4 * L, centre.z);
+    sun.target.position.set(centre.x, 0, centre.z);
+    sun.target.updateMatrixWorld();
+    Object.assign(sun.shadow.camera, { left: -radius, right: radius, top: radius, bottom: -radius, near: 0.1 * L, far: centre.y + 8 * L });
+    sun.shadow.camera.updateProjectionMatrix();
+    const rgba = await renderTo(cam, w, h);
+    follow();
+    return { view: 'grid', width: w, height: h, rgba: toBase64(rgba) };
   }
 
   const spawnTimes = [];
@@ -267,6 +299,24 @@ async function main() {
       // Without drawing, the new bodies stay dirty until the next flush (the next tick's one upload).
       if (draw) { pop.flush(); render(); }
       return ids;
+    },
+    /**
+     * The genetics grid: every body replaced by n×n individuals with seeds seed, seed+1, … in rows
+     * `spacing` body lengths apart, drawn at once unless `draw` is false (then they wait for the next
+     * tick's one upload and deform). Returns [{ id, seed, position }] (the Python reference re-simulates
+     * each from its seed and position).
+     */
+    grid(n = 8, seed = 0, spacing = 2, draw = true) {
+      if (n * n > pop.capacity) throw new Error(`grid: ${n}×${n} needs capacity ${n * n} (this lab has ${pop.capacity}; add ?capacity=)`);
+      for (let i = 0; i < pop.capacity; i++) if (pop.instance(i).alive) pop.despawn(i);
+      const bodies = [];
+      for (let i = 0; i < n * n; i++) {
+        const position = [((i % n) - (n - 1) / 2) * spacing * L, 0, (Math.floor(i / n) - (n - 1) / 2) * spacing * L];
+        const s = (seed + i) >>> 0;
+        bodies.push({ id: pop.spawn({ seed: s, position }), seed: s, position });
+      }
+      if (draw) { pop.flush(); render(); }
+      return bodies;
     },
     despawnAll(keep = []) {
       for (let i = 0; i < pop.capacity; i++) if (pop.instance(i).alive && !keep.includes(i)) pop.despawn(i);
@@ -359,7 +409,7 @@ function wireControls(lab, modes) {
     } catch (e) { out.textContent = String(e); }
   };
   document.getElementById('step').onclick = () => lab.stepTicks(1);
-  document.getElementById('grid').onclick = () => lab.spawn(100, 63);
+  document.getElementById('grid').onclick = () => lab.grid(8);
   let playing = false;
   // Play at a fixed 1/60 s per animation frame: deterministic whatever the display rate.
   const loop = () => { if (!playing) return; lab.update(1 / 60); requestAnimationFrame(loop); };

@@ -12,6 +12,7 @@ import os
 import re
 import sys
 from collections.abc import Sequence
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
@@ -19,6 +20,7 @@ import numpy as np
 from . import __version__
 from .candidates import TIERS, describe_candidates
 from .creature.build import build_creature
+from .creature.morphology import identity_genes, variant_bytes
 from .creature.picture import PICTURE_PATH, picture_unavailable
 from .emit import PackageWriteError
 from .field.sampler import sample
@@ -84,6 +86,17 @@ def _schema(args: argparse.Namespace) -> int:
     return EXIT_OK
 
 
+def _positive_int(text: str) -> int:
+    """argparse type of --population: a whole number >= 1 (argparse then exits 2 naming the option)."""
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"must be a whole number (got {text!r})") from None
+    if not 1 <= value <= 64:
+        raise argparse.ArgumentTypeError(f"must be between 1 and 64 (got {value})")
+    return value
+
+
 def _build(args: argparse.Namespace) -> int:
     source = Path(args.spec)
     try:
@@ -140,21 +153,82 @@ def _print_gates(build: SurfaceBuild) -> None:
         print(f"  gate {gate.name}: {gate.value:.4g} {gate.unit} ({relation} {gate.threshold:.4g}) {verdict}")
 
 
-def _build_creature(args: argparse.Namespace, spec: CharacterSpec, data: bytes) -> int:
+@dataclass(frozen=True)
+class _Identity:
+    """One geometry identity ready to write: its spec (and the JSON bytes it ships), rig and surface."""
+
+    name: str
+    spec: CharacterSpec
+    data: bytes
+    rig: CompiledRig
+    build: SurfaceBuild
+
+
+def _identity(args: argparse.Namespace, name: str, spec: CharacterSpec, data: bytes) -> _Identity | None:
+    """Compile, extract and gate one identity; None (errors printed, naming the gate or part) on failure."""
     try:
         rig = compile_rig(spec)
     except RigCompileError as exc:
-        print_errors(args.spec, exc.errors)
-        return EXIT_INVALID
-    print(
-        f"==> surface {args.tier}: narrow-band sampling, extraction, gates, skin weights, deformation sweeps"
-    )
-    build = _surface(args.spec, spec, rig, args.tier, args.backend)
+        print_errors(name, exc.errors)
+        return None
+    steps = "narrow-band sampling, extraction, gates, skin weights, deformation sweeps"
+    print(f"==> surface {args.tier}: {steps}")
+    build = _surface(name, spec, rig, args.tier, args.backend)
     if build is None:
-        return EXIT_INVALID
+        return None
     _print_gates(build)
     counts = build.sidecar["counts"]
     print(f"  mesh {counts}; " + ("cache hit" if build.cached else "extracted"))
+    return _Identity(name, spec, data, rig, build)
+
+
+#: Morphology variants drawn per identity asked for before --population gives up.
+DRAWS_PER_IDENTITY = 4
+
+
+def _identities(args: argparse.Namespace, spec: CharacterSpec, data: bytes) -> list[_Identity] | None:
+    """The authored identity and, with ``--population N``, N - 1 morphology variants (creature/morphology.py).
+    A variant that fails validation or a surface gate is rejected (the reason printed) and the next index is
+    drawn, so identity names follow draw indices; None when the authored spec fails, or when N identities
+    do not pass within DRAWS_PER_IDENTITY·N draws."""
+    authored = _identity(args, args.spec, spec, data)
+    if authored is None:
+        return None
+    out = [authored]
+    document = json.loads(data)
+    bound = spec.genetics.morphology
+    index = 0
+    while len(out) < args.population and index < DRAWS_PER_IDENTITY * args.population:
+        index += 1
+        name = f"{args.spec} (identity m{index})"
+        genes = identity_genes(spec.seed, index)
+        scaled = ", ".join(f"{g} x{1.0 + bound * v:.3f}" for g, v in genes.items())
+        print(f"==> identity m{index} ({len(out) + 1} of {args.population}): {scaled}")
+        variant_data = variant_bytes(document, index, bound)
+        try:
+            variant = validate_bytes(variant_data, name)
+        except SpecValidationError as exc:
+            print_errors(name, exc.errors)
+            variant = None
+        one = _identity(args, name, variant, variant_data) if isinstance(variant, CharacterSpec) else None
+        if one is None:
+            print(f"  identity m{index} rejected (above); drawing the next")
+            continue
+        out.append(one)
+    if len(out) < args.population:
+        print(
+            f"{args.spec}: only {len(out)} of {args.population} identities passed every gate "
+            f"in {index} draws; nothing was written (lower genetics.morphology or --population)",
+            file=sys.stderr,
+        )
+        return None
+    return out
+
+
+def _build_creature(args: argparse.Namespace, spec: CharacterSpec, data: bytes) -> int:
+    identities = _identities(args, spec, data)
+    if identities is None:
+        return EXIT_INVALID
     print("==> package: candidate program tapes, locomotion data, templates")
     picture = args.picture == "on"
     if args.picture == "auto":
@@ -164,18 +238,22 @@ def _build_creature(args: argparse.Namespace, spec: CharacterSpec, data: bytes) 
             print(f"  no README picture: the lab cannot run here ({reason}); --picture off to silence this")
     if picture:
         print(f"==> picture: {PICTURE_PATH} rendered by the lab (headless Chromium, WebGPU on SwiftShader)")
-    try:
-        folder = build_creature(spec, rig, data, build, Path(args.out), picture=picture)
-    except PackageWriteError as exc:
-        print(f"{args.spec}: cannot write the package: {exc}", file=sys.stderr)
-        return EXIT_INVALID
-    except RuntimeError as exc:
-        if not picture:
-            raise
-        print(f"{args.spec}: cannot render the README picture ({exc}); nothing was written.", file=sys.stderr)
-        print("  build without it: --picture off", file=sys.stderr)
-        return EXIT_GATE_FAILED
-    print(f"wrote {folder}/")
+    for one in identities:
+        try:
+            folder = build_creature(one.spec, one.rig, one.data, one.build, Path(args.out), picture=picture)
+        except PackageWriteError as exc:
+            print(f"{one.name}: cannot write the package: {exc}", file=sys.stderr)
+            return EXIT_INVALID
+        except RuntimeError as exc:
+            if not picture:
+                raise
+            print(
+                f"{one.name}: cannot render the README picture ({exc}); it was not written.", file=sys.stderr
+            )
+            print("  build without it: --picture off", file=sys.stderr)
+            return EXIT_GATE_FAILED
+        digest = one.build.signatures["geometryDigest"]
+        print(f"wrote {folder}/ (geometryDigest {digest[:12]})")
     return EXIT_OK
 
 
@@ -382,6 +460,15 @@ def build_parser() -> argparse.ArgumentParser:
         choices=("auto", "on", "off"),
         help="creature packages: render the README picture in the lab before committing the package "
         "(auto: when Chromium and web_lab/node_modules are there; default $CREATUREGEN_PICTURE or auto)",
+    )
+    build.add_argument(
+        "--population",
+        type=_positive_int,
+        default=1,
+        metavar="N",
+        help="creature specs: N geometry identities, the authored one and N-1 morphology variants within "
+        "genetics.morphology (each its own package <slug>-m<i>, extracted and gated; nothing is written "
+        "unless all pass)",
     )
     build.set_defaults(run=_build)
 

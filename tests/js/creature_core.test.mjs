@@ -37,7 +37,8 @@ test('LCG draws are exactly equal', () => {
 });
 
 test('instanceYaw matches to 1e-12', () => {
-  for (const { seed, yaw } of ref.instances) {
+  for (const { seed, mixed, yaw } of ref.instances) {
+    assert.equal(core.mixSeed(seed), mixed, `seed ${seed}: mixSeed`);
     const got = core.instanceYaw(seed, data.lcg);
     assert.ok(Math.abs(got - yaw) <= 1e-12, `seed ${seed}: yaw ${got} vs ${yaw}`);
   }
@@ -56,10 +57,11 @@ test('pose rows and root rows from the motion core match the reference bit for b
   let frames = 0, minSquash = Infinity, maxSquash = -Infinity;
   for (const { seed, frames: expected } of ref.cases) {
     const motion = core.createMotion(data.motion, data.lcg, { water: core.createAnalyticWater(), seed });
+    const colours = core.genomeColours(data, core.drawGenome(seed, data.lcg), new Float64Array(3 * ref.slotCount));
     for (const frame of expected) {
       if (frame.tick) motion.step();
       assert.equal(motion.tick, frame.tick);
-      core.writePoseRows(data, motion.quats, motion.trans, tmp, page, pad, local);
+      core.writePoseRows(data, motion.quats, motion.trans, colours, 0, tmp, page, pad, local);
       core.writeRootRows(motion.root, 1, page, pad + rowFloats);
       for (let i = 0; i < total; i++) {
         if (bits[pad + i] !== frame.rowBits[i]) assert.fail(`seed ${seed} tick ${frame.tick}: row float ${i} is ${page[pad + i]}`);

@@ -15,6 +15,7 @@ import numpy as np
 
 from .. import __version__
 from ..candidates import TierRejectedError, build_candidates
+from ..field import layout as col
 from ..field.floors import floors_for
 from ..field.primitives import GRADIENT_FLOOR, slot_uses_round_cone
 from ..motion.rig import build_motion
@@ -24,6 +25,7 @@ from ..surface import correct as correction
 from ..surface.build import NO_PROGRAM, SurfaceBuild
 from ..surface.deform import METHODS
 from ..surface.skeleton import Skeleton, build_skeleton
+from .genome import genetics_data, slot_lab
 from .pose import LCG_A, LCG_C, POSE_ROWS
 from .tape import Tape, compile_tape
 
@@ -90,6 +92,9 @@ def build_plan(
         "slotNames": list(skeleton.names),
         "roundCone": [int(x) for x in slot_uses_round_cone(rig.slots)],
         "lcg": {"a": LCG_A, "c": LCG_C},
+        # Colour genes mutate these OKLab coordinates of the authored colours (creature/genome.py).
+        "genetics": genetics_data(spec.genetics.hue, spec.genetics.chroma, spec.genetics.lightness),
+        "slotLab": slot_lab(rig.slots[:, col.RGB]),
         "motion": motion,
         "tickRate": motion["hz"],
         "programData": program_data(tapes),

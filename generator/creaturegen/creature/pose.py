@@ -5,7 +5,8 @@ its per-slot quaternions and translations, ``x' = R(q_s)·x + t_s`` in creature-
 (position, heading cos/sin, squash) that the material applies once. The JS core writes them as float32
 rows (core/pose.js writePoseRows, the same arithmetic in the same order as ``pose_rows``):
 
-- per slot, POSE_ROWS vec4: (a, ra), (b, rb), (k, rgb), quaternion xyzw, (t, roundCone);
+- per slot, POSE_ROWS vec4: (a, ra), (b, rb), (k, rgb), quaternion xyzw, (t, roundCone), where rgb is
+  the individual's colour (creature/genome.py genome_colours);
 - after the slots, two root rows: (x, y, z, alive), (cos yaw, sin yaw, squash, 0).
 
 The LCG is integer arithmetic, identical in Python and JS, so the reference reproduces any spawned
@@ -40,9 +41,25 @@ def lcg_next(state: int) -> int:
     return (LCG_A * state + LCG_C) % (1 << 32)
 
 
+def mix_seed(seed: int) -> int:
+    """The first state of an instance's LCG stream: ``seed`` through murmur3's 32-bit finaliser.
+
+    An LCG is affine, so the k-th draws of consecutive seeds would form an arithmetic progression: spawn
+    seeds 0, 1, 2, … would get headings and genes on a regular lattice. The finaliser decorrelates them.
+    """
+    h = seed % (1 << 32)
+    h ^= h >> 16
+    h = (h * 0x85EBCA6B) & 0xFFFFFFFF
+    h ^= h >> 13
+    h = (h * 0xC2B2AE35) & 0xFFFFFFFF
+    h ^= h >> 16
+    return h
+
+
 def instance_yaw(seed: int) -> float:
-    """Yaw in [0, 2π) of an instance spawned from ``seed``: the second LCG draw (the first is reserved)."""
-    second = lcg_next(lcg_next(seed % (1 << 32)))
+    """Yaw in [0, 2π) of an instance spawned from ``seed``: the second draw of its stream (the first is
+    reserved)."""
+    second = lcg_next(lcg_next(mix_seed(seed)))
     return second / 4294967296.0 * 2.0 * math.pi
 
 
@@ -54,9 +71,13 @@ def as_pose(quats: Sequence[Sequence[float]], trans: Sequence[Sequence[float]]) 
 
 
 def pose_rows(
-    rig: CompiledRig, quats: Sequence[Sequence[float]], trans: Sequence[Sequence[float]]
+    rig: CompiledRig,
+    quats: Sequence[Sequence[float]],
+    trans: Sequence[Sequence[float]],
+    colours: Sequence[Sequence[float]] | None = None,
 ) -> npt.NDArray[np.float32]:
-    """(S, POSE_ROWS, 4) float32 rows of one instance's pose page entry, as the JS core writes them."""
+    """(S, POSE_ROWS, 4) float32 rows of one instance's pose page entry, as the JS core writes them;
+    ``colours`` is the individual's per-slot linear rgb (creature/genome.py), else the authored one."""
     slots = rig.slots
     t = np.asarray(trans, dtype=np.float64)
     rows = np.zeros((rig.slot_count, POSE_ROWS, 4))
@@ -66,7 +87,7 @@ def pose_rows(
     rows[:, 0, 3] = slots[:, col.RA]
     rows[:, 1, 3] = slots[:, col.RB]
     rows[:, 2, 0] = slots[:, col.K]
-    rows[:, 2, 1:4] = slots[:, col.RGB]
+    rows[:, 2, 1:4] = slots[:, col.RGB] if colours is None else np.asarray(colours, dtype=np.float64)
     rows[:, 3] = np.asarray(quats, dtype=np.float64)
     rows[:, 4, :3] = t
     rows[:, 4, 3] = slot_uses_round_cone(slots)

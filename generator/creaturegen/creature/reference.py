@@ -26,6 +26,7 @@ from ..spec import CharacterSpec, validate_bytes
 from ..surface.asset import SurfaceAsset, read_glb
 from ..surface.deform import Pose, skin_cor, skin_dq, skin_lbs
 from ..surface.skeleton import build_skeleton
+from .genome import draw_genome, genetics_data, genome_colours, slot_lab
 
 F64 = npt.NDArray[np.float64]
 
@@ -59,6 +60,13 @@ def instance_motion(
     motion = Motion(ref.motion, water=AnalyticWater(), seed=seed, position=position)
     motion.step_ticks(tick)
     return motion
+
+
+def instance_colours(ref: PackageReference, seed: int) -> list[list[float]]:
+    """Per-slot linear rgb of the individual spawned from ``seed`` (its colour genes in OKLab)."""
+    g = ref.spec.genetics
+    lab = slot_lab(ref.rig.slots[:, col.RGB])
+    return genome_colours(genetics_data(g.hue, g.chroma, g.lightness), lab, draw_genome(seed))
 
 
 def field_at(ref: PackageReference, table: F64, points: F64) -> FieldSample:

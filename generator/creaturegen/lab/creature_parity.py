@@ -16,7 +16,10 @@ Gates, all measured in the run (thresholds are relative to the body scale L wher
 - no GPU validation errors; no pipelines and no buffers created by 50 spawns after reveal;
 - stateHash(seekTick(n)) == stateHash(stepTicks(n));
 - motion: the JS locomotion core in the page vs Python (relative 1e-12), and every planted foot as the GPU
-  pose buffer draws it (rows read back, root squash/yaw/position applied) on its plant point.
+  pose buffer draws it (rows read back, root squash/yaw/position applied) on its plant point;
+- genetics grid: 64 individuals (seeds 0..63) spawned in an 8×8 grid and stepped: every one's GPU pose
+  rows (its OKLab-mutated colours and the pose its gait genes give) vs its Python reference, no two
+  individuals alike; parity/grid.png shows them.
 """
 
 from __future__ import annotations
@@ -35,7 +38,9 @@ from playwright.sync_api import Page
 from scipy import ndimage
 
 from ..creature import reference as cref
-from ..creature.pose import as_pose, pose_rows, root_rows
+from ..creature.genome import slot_lab
+from ..creature.pose import POSE_ROWS, as_pose, pose_rows, root_rows
+from ..field import layout as col
 from ..motion.simulate import Motion
 from ..surface.deform import posed_slots
 from .browser import launch_lab_page
@@ -62,6 +67,13 @@ SHADOW_TEXELS = 2.0
 #: (leg lengths); legged bodies must have at least one planted foot at the parity tick.
 FOOT_DRIFT_TOL = 1e-5
 SPAWNS = 50
+#: The genetics grid: side, first seed, spacing (body lengths) and the tick it is compared at.
+GRID_SIDE = 8
+GRID_SEED = 0
+GRID_SPACING = 2.0
+GRID_TICK = 24
+#: Genome colours in the GPU rows vs Python: float32 rounding of values in [0, 1].
+COLOUR_TOL = 1e-7
 
 F64 = npt.NDArray[np.float64]
 
@@ -151,7 +163,10 @@ def _pose_and_field_gates(
     scale = ref.rig.body_scale
     gpu_rows = np.asarray(page.evaluate("() => window.__lab.readPose(0)"), dtype=np.float32)
     rows = np.concatenate(
-        [pose_rows(ref.rig, motion.quats, motion.trans).reshape(-1), root_rows(motion.root).reshape(-1)]
+        [
+            pose_rows(ref.rig, motion.quats, motion.trans, cref.instance_colours(ref, LAB_SEED)).reshape(-1),
+            root_rows(motion.root).reshape(-1),
+        ]
     )
     report.gate(
         "pose rows (slots and root): GPU vs the Python locomotion reference",
@@ -319,7 +334,66 @@ def _pictures(page: Page, package: Path, debug: bool) -> None:
     page.evaluate("() => window.__lab.setDebugMode('off')")
 
 
-GATE_GROUPS = ("population", "hash", "field", "motion", "skin", "shadow")
+def _grid_gates(page: Page, ref: cref.PackageReference, package: Path, report: ParityReport) -> None:
+    """The genetics grid: each individual's GPU pose rows against the Python reference spawned from the same
+    seed and position (the colour rows alone at float32 rounding, all rows relative to L), and how far the
+    individuals differ: colour (OKLab distance of the mean slot colour to the authored one) and pace."""
+    # Not drawn at spawn: the step's one upload and deform pre-pass draws all 64.
+    bodies = page.evaluate(f"() => window.__lab.grid({GRID_SIDE}, {GRID_SEED}, {GRID_SPACING}, false)")
+    page.evaluate(f"() => window.__lab.stepTicks({GRID_TICK})")
+    scale = ref.rig.body_scale
+    slots = ref.rig.slot_count
+    worst_rows = worst_colour = 0.0
+    colours, paces = [], []
+    for body in bodies:
+        gpu = np.asarray(page.evaluate(f"() => window.__lab.readPose({body['id']})"), dtype=np.float32)
+        seed, position = int(body["seed"]), tuple(float(c) for c in body["position"])
+        motion = cref.instance_motion(ref, seed, GRID_TICK, position)  # type: ignore[arg-type]
+        mine = cref.instance_colours(ref, seed)
+        rows = np.concatenate(
+            [
+                pose_rows(ref.rig, motion.quats, motion.trans, mine).reshape(-1),
+                root_rows(motion.root).reshape(-1),
+            ]
+        )
+        got = gpu[: rows.size]
+        worst_rows = max(worst_rows, float(np.abs(got - rows).max()) / scale)
+        colour_rows = got[: slots * POSE_ROWS * 4].reshape(slots, POSE_ROWS, 4)[:, 2, 1:4]
+        worst_colour = max(worst_colour, float(np.abs(colour_rows - np.asarray(mine, np.float32)).max()))
+        colours.append(colour_rows.astype(np.float64).ravel())
+        paces.append(motion.data["speed"] / ref.motion["speed"] if ref.motion["speed"] > 0 else 1.0)
+    report.gate(
+        f"genome colours of {len(bodies)} individuals: GPU pose rows vs Python (OKLab mutation)",
+        worst_colour,
+        COLOUR_TOL,
+        "linear rgb",
+    )
+    report.gate(
+        f"pose rows of {len(bodies)} individuals at tick {GRID_TICK}: GPU vs Python (gait genes)",
+        worst_rows,
+        1e-6,
+        "L",
+    )
+    flat = np.asarray(colours)
+    gaps = np.linalg.norm(flat[:, None, :] - flat[None, :, :], axis=2)[np.triu_indices(len(flat), 1)]
+    report.gate(
+        "individuals with identical colours in the grid", int(np.count_nonzero(gaps == 0.0)), 0, "pairs"
+    )
+    # How far the individuals stray: OKLab distance of each slot colour from the authored one.
+    authored = np.asarray(slot_lab(ref.rig.slots[:, col.RGB]))
+    shift = np.linalg.norm(np.asarray([slot_lab(c.reshape(-1, 3)) for c in flat]) - authored, axis=2)
+    report.measurements["grid"] = {
+        "bodies": len(bodies),
+        "tick": GRID_TICK,
+        "minColourGapLinear": float(gaps.min()),
+        "oklabShift": {"median": float(np.median(shift)), "max": float(shift.max())},
+        "pace": [float(min(paces)), float(max(paces))],
+    }
+    shot = page.evaluate("() => window.__lab.capturePixels('grid')")
+    write_png(package / "parity" / "grid.png", _rgba(shot))
+
+
+GATE_GROUPS = ("population", "hash", "field", "motion", "skin", "shadow", "grid")
 
 
 def run_creature_parity(
@@ -359,6 +433,8 @@ def run_creature_parity(
         t = time.perf_counter()
         _pictures(page, package, debug_pictures)
         seconds["pictures"] = time.perf_counter() - t
+        # Last: the grid replaces every body (instance 0 included) of the lab.
+        phase("grid", lambda: _grid_gates(page, ref, package, report))
         page.evaluate("() => window.__lab.finish()")
         errors: list[str] = page.evaluate("() => window.__lab.errors")
         report.gate("GPU validation errors", len(errors), 0, "errors")

@@ -48,6 +48,14 @@ ROPE_DAMPING: Final = 0.02
 ROPE_BEND_LIMIT_DEG: Final = 60.0
 
 WALKERS: Final = ("biped", "quadruped", "hexapod")
+#: locomotion type -> its gait genes, each the motion-data fields one gene scales together
+#: (creature/genome.py express_gait): pace scales speed with step or hop length, so timing in ticks holds.
+GAIT_GENES: Final[dict[str, tuple[tuple[str, ...], ...]]] = {
+    **dict.fromkeys(WALKERS, (("speed", "stepLength"), ("stepHeight",))),
+    "hopper": (("speed", "hopLength"), ("hopHeight",)),
+    "flyer": (("speed",), ("pathRadius",), ("altitude",)),
+    "swimmer": (("speed",), ("undulation",)),
+}
 
 
 def _v(x: Any) -> list[float]:
@@ -195,4 +203,5 @@ def build_motion(spec: CharacterSpec, rig: CompiledRig, skeleton: Skeleton) -> d
         },
         # Rope nodes of creatures that stand on the support stay above it by their radius.
         "ropeGround": kind in WALKERS or kind == "hopper",
+        "genes": {"jitter": spec.genetics.gait, "fields": [list(g) for g in GAIT_GENES.get(kind, ())]},
     }

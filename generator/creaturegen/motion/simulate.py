@@ -20,6 +20,7 @@ import struct
 from dataclasses import dataclass, field
 from typing import Any
 
+from ..creature.genome import Genome, draw_genome, express_gait
 from ..creature.pose import instance_yaw
 from . import quat as vq
 from .derived import Derived, derive
@@ -88,8 +89,11 @@ class Motion:
         water: AnalyticWater | None = None,
         seed: int = 0,
         position: tuple[float, float, float] = (0.0, 0.0, 0.0),
+        genome: Genome | None = None,
     ) -> None:
-        self.data = data
+        # The individual's motion data: the authored parameters scaled by its gait genes (the seed's, unless
+        # a genome is given).
+        self.data = express_gait(data, genome or draw_genome(seed))
         self.kind = str(data["type"])
         self.support: Support = support or FlatGround()
         self.gravity = gravity or Gravity()
@@ -101,7 +105,7 @@ class Motion:
             if missing:
                 raise TierRefusedError(f"swimmer: the water provider does not represent {', '.join(missing)}")
         self.gravity0 = self.gravity.at(0.0)
-        self.d: Derived = derive(data, self.gravity0)
+        self.d: Derived = derive(self.data, self.gravity0)
         yaw = instance_yaw(seed)
         self.theta0 = -yaw
         self.position = [float(c) for c in position]

@@ -112,6 +112,34 @@ class Locomotion(StrictModel):
     undulation: NonNegative | None = Field(default=None, description="Body undulation amplitude, rad.")
 
 
+class Genetics(StrictModel):
+    """How far one spawned individual may differ from the authored creature (each gene is a seeded draw in
+    [-1, 1) times its bound). Colours mutate in OKLab on the authored sRGB colours: one hue rotation, chroma
+    scale and lightness shift per individual, so the pattern of the body stays coherent. Gait genes scale
+    the locomotion parameters of its type (walkers: pace, i.e. speed with stepLength, and stepHeight).
+    Morphology bounds the build-time identities of ``build --population N``, never a spawn."""
+
+    hue: Annotated[Number, Field(ge=0, le=180)] = Field(
+        default=20.0, description="Largest hue rotation in the OKLab a-b plane, degrees."
+    )
+    chroma: Annotated[Number, Field(ge=0, le=0.5)] = Field(
+        default=0.2, description="Largest relative change of OKLab chroma."
+    )
+    lightness: Annotated[Number, Field(ge=0, le=0.25)] = Field(
+        default=0.06, description="Largest shift of OKLab lightness L (0..1)."
+    )
+    gait: Annotated[Number, Field(ge=0, le=0.25)] = Field(
+        default=0.08,
+        description="Largest relative change of each gait gene (a walker's step length stays "
+        "within its reach limit).",
+    )
+    morphology: Annotated[Number, Field(ge=0, le=0.25)] = Field(
+        default=0.1,
+        description="Largest relative change of girth, limb and tail length between the geometry "
+        "identities of `creaturegen build --population N` (never at spawn: a new shape is a new mesh).",
+    )
+
+
 class Part(StrictModel):
     """One body part. Which fields apply depends on ``shape`` (see SHAPE_FIELDS)."""
 
@@ -199,6 +227,9 @@ class CharacterSpec(StrictModel):
         default=1.0, description="Multiplies every length and radius."
     )
     locomotion: Locomotion | None = None
+    genetics: Genetics = Field(
+        default_factory=Genetics, description="Bounds of per-individual variation drawn by spawn(seed)."
+    )
     parts: Annotated[list[Part], Field(min_length=1)]
     blend: Blend | None = Field(default=None, description="Blend graph; omitted means the default graph.")
     maxParts: Annotated[StrictInt, Field(ge=1, le=256)] = Field(

@@ -5,10 +5,20 @@ type Vec = ArrayLike<number> & { [index: number]: number };
 
 export const CREATURE: Readonly<Record<string, unknown>>;
 export function lcgNext(state: number, a: number, c: number): number;
+/** The first state of an instance's LCG stream (murmur3's 32-bit finaliser of the seed). */
+export function mixSeed(seed: number): number;
 export function instanceYaw(seed: number, lcg: { a: number; c: number }): number;
 /** R(q)·v with q at q[qo..qo+3] (xyzw) and v at v[vo..vo+2]; vectors travel as (array, offset) so no call boxes a double. */
 export function rotate(q: ArrayLike<number>, qo: number, v: ArrayLike<number>, vo: number, out: Vec, o: number): void;
-export function writePoseRows(data: unknown, quats: ArrayLike<number>, trans: ArrayLike<number>, tmp: Float64Array, target: Float32Array, base: number, bounds: Float64Array): void;
+export function writePoseRows(data: unknown, quats: ArrayLike<number>, trans: ArrayLike<number>, colours: ArrayLike<number> | null, co: number, tmp: Float64Array, target: Float32Array, base: number, bounds: Float64Array): void;
+/** Floats in a genome: hue, chroma, lightness, then the gait genes (signed, in [-1, 1)). */
+export const GENOME_LENGTH: number;
+/** The genome of the individual spawned from `seed` (LCG draws 3 onwards). */
+export function drawGenome(seed: number, lcg: { a: number; c: number }, out?: Float64Array): Float64Array;
+/** Per-slot linear rgb of an individual (its colour genes applied in OKLab to the authored colours). */
+export function genomeColours(data: unknown, genome: ArrayLike<number>, out: Float64Array, o?: number): Float64Array;
+/** The motion data of an individual: gene-listed gait parameters scaled by 1 + jitter·gene. */
+export function expressGait<T extends object>(motion: T, genome: ArrayLike<number>): T;
 export function writeRootRows(root: ArrayLike<number>, alive: number, target: Float32Array, at: number): void;
 export function rootBounds(local: ArrayLike<number>, root: ArrayLike<number>, out: Float64Array, at: number): void;
 export function hashBytes(bytes: Uint8Array | Uint8Array[], tick: number): string;
@@ -88,6 +98,8 @@ export function assertWaterFor(kind: string, water: WaterSurfaceProvider | null,
 export function createMotion(data: unknown, lcg: { a: number; c: number }, options?: {
   support?: SupportSurfaceProvider; gravity?: GravityProvider; water?: WaterSurfaceProvider | null; seed?: number;
   position?: [number, number, number];
+  /** Genes overriding the seed's (drawGenome layout); the heading still comes from the seed. */
+  genome?: ArrayLike<number> | null;
 }): Motion;
 export function createDriver(hz: number): Driver;
 export const MAX_FRAME_S: number;

@@ -1,7 +1,8 @@
 // Pure-JS entry (no three imports): creature data, LCG, pose rows, the .glb reader, stateHash, and the
 // locomotion core (driver, providers, motion) that poses every body.
 export { CREATURE } from './data.js';
-export { lcgNext, instanceYaw } from './lcg.js';
+export { lcgNext, instanceYaw, mixSeed } from './lcg.js';
+export { GENOME_LENGTH, drawGenome, expressGait, genomeColours } from './genome.js';
 export { rootBounds, rotate, writePoseRows, writeRootRows } from './pose.js';
 export { hashBytes } from './hash.js';
 export { parseGlb } from './glb.js';

@@ -9,11 +9,12 @@ export { rotate };
 
 /**
  * Write one instance's slot rows (POSE_ROWS vec4 per slot) into `target` at float offset `base`:
- * (a, ra), (b, rb), (k, rgb), quaternion xyzw, (t, roundCone), from per-slot `quats` (xyzw) and `trans`.
- * `tmp` is a 3-float scratch. Returns the creature-local AABB of the posed primitives into `bounds`
- * (min xyz, max xyz). Allocates nothing.
+ * (a, ra), (b, rb), (k, rgb), quaternion xyzw, (t, roundCone), from per-slot `quats` (xyzw) and `trans`,
+ * and the individual's per-slot linear rgb `colours` at offset `co` (core/genome.js genomeColours; null
+ * writes the authored colours). `tmp` is a 3-float scratch. Returns the creature-local AABB of the posed
+ * primitives into `bounds` (min xyz, max xyz). Allocates nothing.
  */
-export function writePoseRows(data, quats, trans, tmp, target, base, bounds) {
+export function writePoseRows(data, quats, trans, colours, co, tmp, target, base, bounds) {
   const slots = data.slots;
   const rows = data.poseRows;
   let minX = Infinity, minY = Infinity, minZ = Infinity, maxX = -Infinity, maxY = -Infinity, maxZ = -Infinity;
@@ -33,7 +34,13 @@ export function writePoseRows(data, quats, trans, tmp, target, base, bounds) {
       if (y + r > maxY) maxY = y + r;
       if (z + r > maxZ) maxZ = z + r;
     }
-    target[o + 8] = row[8]; target[o + 9] = row[9]; target[o + 10] = row[10]; target[o + 11] = row[11];
+    target[o + 8] = row[8];
+    if (colours) {
+      const c = co + 3 * s;
+      target[o + 9] = colours[c]; target[o + 10] = colours[c + 1]; target[o + 11] = colours[c + 2];
+    } else {
+      target[o + 9] = row[9]; target[o + 10] = row[10]; target[o + 11] = row[11];
+    }
     target[o + 12] = quats[4 * s]; target[o + 13] = quats[4 * s + 1];
     target[o + 14] = quats[4 * s + 2]; target[o + 15] = quats[4 * s + 3];
     target[o + 16] = trans[3 * s]; target[o + 17] = trans[3 * s + 1]; target[o + 18] = trans[3 * s + 2];

@@ -9,6 +9,7 @@ import { instancedArray } from 'three/tsl';
 import { CREATURE } from '../core/data.js';
 import { parseGlb } from '../core/glb.js';
 import { hashBytes } from '../core/hash.js';
+import { GENOME_LENGTH, drawGenome, genomeColours } from '../core/genome.js';
 import { createDriver } from '../core/motion/driver.js';
 import { assertWaterFor, createMotion } from '../core/motion/motion.js';
 import { createFlatGround, createGravity } from '../core/motion/providers.js';
@@ -123,6 +124,7 @@ export async function createCreaturePopulation(renderer, options = {}) {
       first, size, pose, mesh, staging: pose.value.array, deform, deformView: deformView(deform), kernels: new Map(), shell: null,
       alive: new Uint8Array(size), seed: new Uint32Array(size), spawnTick: new Float64Array(size),
       motions: new Array(size).fill(null), bounds: new Float64Array(6 * size),
+      genomes: new Float64Array(GENOME_LENGTH * size), colours: new Float64Array(3 * data.slotCount * size),
       dirtyLo: Infinity, dirtyHi: -1,
     });
   }
@@ -175,7 +177,7 @@ export async function createCreaturePopulation(renderer, options = {}) {
   // and its world bounds; marks the instance dirty for the next flush.
   function writeInstance(page, j, quats, trans, root) {
     const base = j * floatsPerInstance;
-    writePoseRows(data, quats, trans, tmp, page.staging, base, localBox);
+    writePoseRows(data, quats, trans, page.colours, 3 * data.slotCount * j, tmp, page.staging, base, localBox);
     writeRootRows(root, page.alive[j], page.staging, base + rootRow);
     rootBounds(localBox, root, page.bounds, 6 * j);
     page.dirtyLo = Math.min(page.dirtyLo, j);
@@ -273,9 +275,10 @@ export async function createCreaturePopulation(renderer, options = {}) {
     support, gravity, water,
     /**
      * Validate and add one body at `position` (its path starts there; the locomotion core puts it on the
-     * support, on the water or at the flyer's altitude), heading from its seed. Builds its CPU motion state
-     * and writes O(slots) rows: no geometry, material, buffer or pipeline is created. Its motion starts at its
-     * own tick 0.
+     * support, on the water or at the flyer's altitude). Its seed is its genome (core/genome.js): heading,
+     * colour genes (hue, chroma, lightness in OKLab) and gait genes, within the package's genetics bounds.
+     * Builds its CPU motion state and writes O(slots) rows: no geometry, material, buffer or pipeline is
+     * created. Its motion starts at its own tick 0.
      */
     spawn({ seed = 0, position = [0, 0, 0] } = {}) {
       if (!Number.isInteger(seed) || seed < 0 || seed > 0xffffffff) throw new Error(`spawn.seed: an integer in [0, 2^32) (got ${seed})`);
@@ -286,6 +289,8 @@ export async function createCreaturePopulation(renderer, options = {}) {
         for (let j = 0; j < page.size; j++) {
           if (page.alive[j]) continue;
           page.motions[j] = createMotion(data.motion, data.lcg, { support, gravity, water, seed, position });
+          const genome = drawGenome(seed, data.lcg, page.genomes.subarray(GENOME_LENGTH * j, GENOME_LENGTH * (j + 1)));
+          genomeColours(data, genome, page.colours, 3 * data.slotCount * j);
           page.alive[j] = 1;
           page.seed[j] = seed;
           page.spawnTick[j] = tick;
@@ -359,7 +364,8 @@ export async function createCreaturePopulation(renderer, options = {}) {
       const { page, j } = locate(id);
       const m = page.motions[j];
       return { index: j, alive: page.alive[j] === 1, seed: page.seed[j], spawnTick: page.spawnTick[j],
-        tick: m ? m.tick : null, root: m ? Array.from(m.root) : null, bounds: Array.from(page.bounds.subarray(6 * j, 6 * j + 6)) };
+        tick: m ? m.tick : null, root: m ? Array.from(m.root) : null, bounds: Array.from(page.bounds.subarray(6 * j, 6 * j + 6)),
+        genome: m ? Array.from(page.genomes.subarray(GENOME_LENGTH * j, GENOME_LENGTH * (j + 1))) : null };
     },
     /** The locomotion core of a live instance (createMotion: state, gates, renderPose), or null. */
     motion(id) {

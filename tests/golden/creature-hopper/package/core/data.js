@@ -20,6 +20,11 @@ export const CREATURE = Object.freeze({
   ],
   "deformStride": 3,
   "fullProgram": 54,
+  "genetics": {
+    "chroma": 0.2,
+    "hueRad": 0.3490658503988659,
+    "lightness": 0.06
+  },
   "gradientFloor": 1e-12,
   "kFloor": 0.00124,
   "lcg": {
@@ -49,6 +54,18 @@ export const CREATURE = Object.freeze({
       "strouhal": 0.3,
       "swimResponse": 1.0,
       "swingFroude": 1.0
+    },
+    "genes": {
+      "fields": [
+        [
+          "speed",
+          "hopLength"
+        ],
+        [
+          "hopHeight"
+        ]
+      ],
+      "jitter": 0.08
     },
     "groundY": -0.06,
     "groups": 0,
@@ -3119,6 +3136,43 @@ export const CREATURE = Object.freeze({
     "topologySignature": "d997bf5a05460ff68faead98d301d8766cd723bba06ded7b59f9e73102ccda75"
   },
   "slotCount": 7,
+  "slotLab": [
+    [
+      0.6533914592712567,
+      -0.0015519578906341344,
+      -0.06706245035577166
+    ],
+    [
+      0.7792834618736469,
+      0.031999245077566546,
+      0.08411692115755201
+    ],
+    [
+      0.5358725672976113,
+      0.025254005124299633,
+      0.06430191004160372
+    ],
+    [
+      0.5358725672976113,
+      0.025254005124299633,
+      0.06430191004160372
+    ],
+    [
+      0.5358725672976113,
+      0.025254005124299633,
+      0.06430191004160372
+    ],
+    [
+      0.5358725672976113,
+      0.025254005124299633,
+      0.06430191004160372
+    ],
+    [
+      0.5358725672976113,
+      0.025254005124299633,
+      0.06430191004160372
+    ]
+  ],
   "slotNames": [
     "part.core",
     "part.belly",

@@ -11,6 +11,7 @@
 // Integer ticks are authoritative: seekTick(n) resets and steps n times, so it equals n step() calls bit
 // for bit. Nothing allocates after createMotion (typed scratch only); the only variation is the seeded LCG.
 
+import { drawGenome, expressGait } from '../genome.js';
 import { instanceYaw } from '../lcg.js';
 import { hashBytes } from '../hash.js';
 import { axisAngle, fromFrames, fromTo, gramSchmidt, mul, normalizeInto, rotate } from './quat.js';
@@ -34,8 +35,10 @@ export function assertWaterFor(kind, water, who = kind) {
   if (missing.length) throw new TierRefusedError(`${who}: the water provider does not represent ${missing.join(', ')}`);
 }
 
-export function createMotion(data, lcg, { support = createFlatGround(), gravity = createGravity(), water = null, seed = 0, position = [0, 0, 0] } = {}) {
-  const m = data;
+export function createMotion(data, lcg, { support = createFlatGround(), gravity = createGravity(), water = null, seed = 0, position = [0, 0, 0], genome = null } = {}) {
+  // The individual's motion data: the authored parameters scaled by its gait genes (the seed's, unless a
+  // genome is given).
+  const m = expressGait(data, genome ?? drawGenome(seed, lcg));
   const kind = m.type;
   assertWaterFor(kind, water);
   const gravity0 = gravity.at(0, new Float64Array(3));

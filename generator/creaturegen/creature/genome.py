@@ -1,0 +1,152 @@
+"""Genomes: what makes one spawned individual differ from another, drawn from its seed by the LCG.
+
+A genome is a handful of signed genes in [-1, 1), each the draw at a fixed index of the LCG stream that
+starts at ``mix_seed(seed)`` (draw 1 is reserved, draw 2 is the heading, see pose.instance_yaw):
+
+- draws 3, 4, 5: hue, chroma, lightness, applied in OKLab to every authored colour (one rotation, one
+  scale and one shift per individual, so the body's pattern stays coherent). The authored sRGB hex is the
+  only input: its OKLab coordinates are computed at build time (``slot_lab``) and shipped; the runtime
+  only mutates them and converts back (cubes and 3×3 products, no cube root), so Python and JS agree bit
+  for bit.
+- draws 6 onwards: one gait gene per group of the locomotion type's gene list (``motion["genes"]``), each
+  scaling its parameters by ``1 + jitter·gene``; a walker's step length stays within its reach limit.
+
+The JS core (core/genome.js) runs the same scalar arithmetic in the same order.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Any, Final
+
+import numpy as np
+import numpy.typing as npt
+
+from ..motion.trig import pcos, psin
+from .pose import lcg_next, mix_seed
+
+#: Draw index (1-based) of each gene; the gait genes follow GAIT_DRAW in gene-list order.
+HUE_DRAW: Final = 3
+CHROMA_DRAW: Final = 4
+LIGHTNESS_DRAW: Final = 5
+GAIT_DRAW: Final = 6
+#: Gait genes a type may carry (the longest gene list).
+MAX_GAIT_GENES: Final = 3
+
+# Björn Ottosson's OKLab matrices (linear sRGB -> LMS, LMS' -> Lab, and their inverses).
+_M1: Final = (
+    (0.4122214708, 0.5363325363, 0.0514459929),
+    (0.2119034982, 0.6806995451, 0.1073969566),
+    (0.0883024619, 0.2817188376, 0.6299787005),
+)
+_M2: Final = (
+    (0.2104542553, 0.7936177850, -0.0040720468),
+    (1.9779984951, -2.4285922050, 0.4505937099),
+    (0.0259040371, 0.7827717662, -0.8086757660),
+)
+_M2_INV: Final = (
+    (1.0, 0.3963377774, 0.2158037573),
+    (1.0, -0.1055613458, -0.0638541728),
+    (1.0, -0.0894841775, -1.2914855480),
+)
+_M1_INV: Final = (
+    (4.0767416621, -3.3077115913, 0.2309699292),
+    (-1.2684380046, 2.6097574011, -0.3413193965),
+    (-0.0041960863, -0.7034186147, 1.7076147010),
+)
+
+
+@dataclass(frozen=True)
+class Genome:
+    """Signed genes in [-1, 1) of one individual."""
+
+    hue: float
+    chroma: float
+    lightness: float
+    gait: tuple[float, ...]
+
+
+def _signed(draw: int) -> float:
+    return draw / 2147483648.0 - 1.0
+
+
+def draw_genome(seed: int) -> Genome:
+    """The genome of the individual spawned from ``seed`` (the same draws as core/genome.js drawGenome)."""
+    state = mix_seed(seed)
+    draws = []
+    for _ in range(GAIT_DRAW + MAX_GAIT_GENES - 1):
+        state = lcg_next(state)
+        draws.append(_signed(state))
+    gait_from = GAIT_DRAW - 1
+    return Genome(
+        hue=draws[HUE_DRAW - 1],
+        chroma=draws[CHROMA_DRAW - 1],
+        lightness=draws[LIGHTNESS_DRAW - 1],
+        gait=tuple(draws[gait_from : gait_from + MAX_GAIT_GENES]),
+    )
+
+
+def slot_lab(rgb_linear: npt.NDArray[np.float64]) -> list[list[float]]:
+    """OKLab (L, a, b) of each slot's authored colour, from its linear sRGB (build time, shipped as data)."""
+    lms = np.cbrt(np.asarray(rgb_linear, dtype=np.float64) @ np.asarray(_M1).T)
+    lab: list[list[float]] = (lms @ np.asarray(_M2).T).tolist()
+    return lab
+
+
+def _row(m: tuple[tuple[float, float, float], ...], i: int, x: float, y: float, z: float) -> float:
+    return m[i][0] * x + m[i][1] * y + m[i][2] * z
+
+
+def linear_from_oklab(lab: tuple[float, float, float]) -> tuple[float, float, float]:
+    """Linear sRGB of an OKLab colour, each channel clamped to [0, 1] (out-of-gamut mutations clip)."""
+    big_l, a, b = lab
+    l_ = _row(_M2_INV, 0, big_l, a, b)
+    m_ = _row(_M2_INV, 1, big_l, a, b)
+    s_ = _row(_M2_INV, 2, big_l, a, b)
+    lc, mc, sc = l_ * l_ * l_, m_ * m_ * m_, s_ * s_ * s_
+    return (
+        min(1.0, max(0.0, _row(_M1_INV, 0, lc, mc, sc))),
+        min(1.0, max(0.0, _row(_M1_INV, 1, lc, mc, sc))),
+        min(1.0, max(0.0, _row(_M1_INV, 2, lc, mc, sc))),
+    )
+
+
+def genome_colours(genetics: dict[str, Any], lab: list[list[float]], genome: Genome) -> list[list[float]]:
+    """Per-slot linear rgb of an individual: hue rotated, chroma scaled and lightness shifted in OKLab."""
+    angle = genetics["hueRad"] * genome.hue
+    cos, sin = pcos(angle), psin(angle)
+    scale = 1.0 + genetics["chroma"] * genome.chroma
+    shift = genetics["lightness"] * genome.lightness
+    out = []
+    for big_l, a, b in lab:
+        lightness = min(1.0, max(0.0, big_l + shift))
+        out.append(
+            list(linear_from_oklab((lightness, (cos * a - sin * b) * scale, (sin * a + cos * b) * scale)))
+        )
+    return out
+
+
+def genetics_data(hue_deg: float, chroma: float, lightness: float) -> dict[str, float]:
+    """The plan's colour genetics (the hue bound in radians, as the runtime uses it)."""
+    return {"hueRad": math.radians(hue_deg), "chroma": chroma, "lightness": lightness}
+
+
+def express_gait(motion: dict[str, Any], genome: Genome) -> dict[str, Any]:
+    """The motion data of an individual: gait gene ``i`` scales every field of ``genes.fields[i]`` by
+    ``1 + jitter·gene``. The authored data is not modified.
+
+    A walker's pace gene scales speed and stepLength together, so its stance lasts the same number of ticks
+    and its phase windows open as authored; the factor is capped where stepLength would pass the reach
+    limit (``stepLimit``). Scaling speed alone, or step length alone, lets a foot lag past its reach
+    before its window opens (measured: hundreds of reach-clamped ticks at the corners of an 8 % box).
+    """
+    genes = motion["genes"]
+    expressed = dict(motion)
+    for i, group in enumerate(genes["fields"]):
+        factor = 1.0 + genes["jitter"] * genome.gait[i]
+        if "stepLength" in group and motion["stepLength"] > 0.0:
+            factor = min(factor, motion["stepLimit"] / motion["stepLength"])
+        for name in group:
+            expressed[name] = motion[name] * factor
+    return expressed
