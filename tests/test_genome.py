@@ -206,3 +206,19 @@ def test_build_population_refuses_a_bad_count(value: str, tmp_path: Path) -> Non
     assert done.returncode == 2
     assert "--population" in done.stderr
     assert not any(tmp_path.iterdir())
+
+
+def test_build_population_is_for_creatures_only(tmp_path: Path) -> None:
+    done = run_cli(
+        "build", str(EXAMPLES / "frost" / "frost-full.json"), "-o", str(tmp_path), "--population", "2"
+    )
+    assert done.returncode == 2
+    assert "--population: applies to creature specs only" in done.stderr
+    assert not any(tmp_path.iterdir())
+
+
+def test_morphology_leaves_explicit_nulls_alone() -> None:
+    document = json.loads((EXAMPLES / "lizard.json").read_text())
+    document["parts"][0]["k"] = None
+    variant = variant_document(document, 1, 0.1)
+    assert variant["parts"][0]["k"] is None

@@ -27,7 +27,7 @@ from .field.sampler import sample
 from .frost.build import build_frost
 from .rig import CompiledRig, RigCompileError, compile_rig
 from .rig.report import describe_rig
-from .spec import CharacterSpec, SpecError, SpecValidationError, load_spec, validate_bytes
+from .spec import CharacterSpec, SpecError, SpecValidationError, load_spec, slugify, validate_bytes
 from .spec.schema import stale_schemas, write_schemas
 from .spec.summary import summarize
 from .surface.asset import SurfaceCache
@@ -87,7 +87,7 @@ def _schema(args: argparse.Namespace) -> int:
 
 
 def _positive_int(text: str) -> int:
-    """argparse type of --population: a whole number >= 1 (argparse then exits 2 naming the option)."""
+    """argparse type of --population: a whole number in [1, 64] (argparse then exits 2 naming the option)."""
     try:
         value = int(text)
     except ValueError:
@@ -113,6 +113,9 @@ def _build(args: argparse.Namespace) -> int:
     print("\n".join(summarize(spec)))
     if isinstance(spec, CharacterSpec):
         return _build_creature(args, spec, data)
+    if args.population != 1:
+        print_errors(args.spec, [SpecError("--population", "applies to creature specs only")])
+        return EXIT_INVALID
     print(
         "==> frost: quantisation gate (30/60/120 FPS replays per storage format), structure maps", flush=True
     )
@@ -210,6 +213,14 @@ def _identities(args: argparse.Namespace, spec: CharacterSpec, data: bytes) -> l
         except SpecValidationError as exc:
             print_errors(name, exc.errors)
             variant = None
+        if isinstance(variant, CharacterSpec) and slugify(variant.name) in {
+            slugify(o.spec.name) for o in out
+        }:
+            print_errors(
+                name,
+                [SpecError("name", "too long for an identity suffix: the slugs of the identities collide")],
+            )
+            return None
         one = _identity(args, name, variant, variant_data) if isinstance(variant, CharacterSpec) else None
         if one is None:
             print(f"  identity m{index} rejected (above); drawing the next")
@@ -466,9 +477,9 @@ def build_parser() -> argparse.ArgumentParser:
         type=_positive_int,
         default=1,
         metavar="N",
-        help="creature specs: N geometry identities, the authored one and N-1 morphology variants within "
-        "genetics.morphology (each its own package <slug>-m<i>, extracted and gated; nothing is written "
-        "unless all pass)",
+        help="creature specs: N (1..64) geometry identities, the authored one and N-1 morphology variants "
+        "within genetics.morphology (each its own package <slug>-m<i>, extracted and gated; a variant "
+        "failing a gate is replaced by the next draw; no package is written before all N passed)",
     )
     build.set_defaults(run=_build)
 

@@ -87,15 +87,20 @@ def draw_genome(seed: int) -> Genome:
     )
 
 
-def slot_lab(rgb_linear: npt.NDArray[np.float64]) -> list[list[float]]:
-    """OKLab (L, a, b) of each slot's authored colour, from its linear sRGB (build time, shipped as data)."""
-    lms = np.cbrt(np.asarray(rgb_linear, dtype=np.float64) @ np.asarray(_M1).T)
-    lab: list[list[float]] = (lms @ np.asarray(_M2).T).tolist()
-    return lab
-
-
 def _row(m: tuple[tuple[float, float, float], ...], i: int, x: float, y: float, z: float) -> float:
+    """Row ``i`` of a 3×3 matrix times (x, y, z), summed left to right as the JS core does."""
     return m[i][0] * x + m[i][1] * y + m[i][2] * z
+
+
+def slot_lab(rgb_linear: npt.NDArray[np.float64]) -> list[list[float]]:
+    """OKLab (L, a, b) of each slot's authored colour (the sRGB hex the rig decoded to linear, where OKLab's
+    forward transform starts). Build time, shipped as data; scalar arithmetic, so no BLAS reordering makes
+    the build's numbers and the parity reference's differ."""
+    out = []
+    for r, g, b in np.asarray(rgb_linear, dtype=np.float64).tolist():
+        lms = [math.cbrt(_row(_M1, i, r, g, b)) for i in range(3)]
+        out.append([_row(_M2, i, *lms) for i in range(3)])
+    return out
 
 
 def linear_from_oklab(lab: tuple[float, float, float]) -> tuple[float, float, float]:
@@ -139,7 +144,7 @@ def express_gait(motion: dict[str, Any], genome: Genome) -> dict[str, Any]:
     A walker's pace gene scales speed and stepLength together, so its stance lasts the same number of ticks
     and its phase windows open as authored; the factor is capped where stepLength would pass the reach
     limit (``stepLimit``). Scaling speed alone, or step length alone, lets a foot lag past its reach
-    before its window opens (measured: hundreds of reach-clamped ticks at the corners of an 8 % box).
+    before its window opens (tests/test_motion.py checks every corner of the gene box).
     """
     genes = motion["genes"]
     expressed = dict(motion)

@@ -45,7 +45,7 @@ def variant_document(document: dict[str, Any], index: int, bound: float) -> dict
     variant["name"] = f"{document['name']} m{index}"
     for part in variant["parts"]:
         for field in ("r", "r2", "k", "kCap"):
-            if field in part:
+            if part.get(field) is not None:
                 part[field] = part[field] * scale["girth"]
         if part.get("shape") == "leg":
             part["upper"] *= scale["limbs"]

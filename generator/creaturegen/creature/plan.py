@@ -130,6 +130,8 @@ def build_plan(
         "specSha256": spec_sha256,
         "runtime": runtime,
         "usage": usage,
+        # The package README's gait-gene line (each gene scales its fields together).
+        "genes": "; ".join(" with ".join(g) for g in motion["genes"]["fields"]) or "nothing (no locomotion)",
         "signatures": dict(surface.signatures),
         "tier": surface.tier,
         "gates": [g.as_dict() for g in surface.gates],

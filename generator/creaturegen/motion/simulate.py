@@ -93,7 +93,7 @@ class Motion:
     ) -> None:
         # The individual's motion data: the authored parameters scaled by its gait genes (the seed's, unless
         # a genome is given).
-        self.data = express_gait(data, genome or draw_genome(seed))
+        self.data = express_gait(data, genome if genome is not None else draw_genome(seed))
         self.kind = str(data["type"])
         self.support: Support = support or FlatGround()
         self.gravity = gravity or Gravity()

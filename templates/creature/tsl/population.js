@@ -288,8 +288,8 @@ export async function createCreaturePopulation(renderer, options = {}) {
       for (const page of pages) {
         for (let j = 0; j < page.size; j++) {
           if (page.alive[j]) continue;
-          page.motions[j] = createMotion(data.motion, data.lcg, { support, gravity, water, seed, position });
           const genome = drawGenome(seed, data.lcg, page.genomes.subarray(GENOME_LENGTH * j, GENOME_LENGTH * (j + 1)));
+          page.motions[j] = createMotion(data.motion, data.lcg, { support, gravity, water, seed, position, genome });
           genomeColours(data, genome, page.colours, 3 * data.slotCount * j);
           page.alive[j] = 1;
           page.seed[j] = seed;
@@ -305,6 +305,8 @@ export async function createCreaturePopulation(renderer, options = {}) {
       const { page, j } = locate(id);
       page.alive[j] = 0;
       page.motions[j] = null;
+      page.genomes.fill(0, GENOME_LENGTH * j, GENOME_LENGTH * (j + 1));
+      page.colours.fill(0, 3 * data.slotCount * j, 3 * data.slotCount * (j + 1));
       page.staging.fill(0, j * floatsPerInstance, (j + 1) * floatsPerInstance);
       page.dirtyLo = Math.min(page.dirtyLo, j);
       page.dirtyHi = Math.max(page.dirtyHi, j);
