@@ -410,7 +410,7 @@ def python_reference(spec_path: Path) -> dict[str, Any]:
     assert isinstance(spec, CharacterSpec)
     rig = compile_rig(spec)
     data = build_motion(spec, rig, build_skeleton(spec, rig))
-    genetics = genetics_data(spec.genetics.hue, spec.genetics.chroma, spec.genetics.lightness)
+    genetics = genetics_data(spec.genetics)
     lab = slot_lab(rig.slots[:, col.RGB])
     lcg = []
     for seed in SEEDS:

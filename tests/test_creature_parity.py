@@ -33,7 +33,8 @@ def build(name: str, out_root: Path) -> Path:
 
 
 #: The genetics grid (64 individuals deformed and each re-simulated in Python) runs on the hopper, the
-#: cheapest body; the others skip it to keep `make test` short (on the lizard it cost about 40 s).
+#: cheapest body; the others skip it to keep `make test` short (`seconds.grid` in each report says what
+#: it costs; `creaturegen parity` runs it everywhere).
 GRID_EXAMPLES = ("reference/hopper.json",)
 
 

@@ -31,6 +31,7 @@ from creaturegen.motion.rig import build_motion
 from creaturegen.rig import compile_rig
 from creaturegen.rig.colour import hex_to_linear
 from creaturegen.spec import CharacterSpec, SpecValidationError, load_spec, slugify, validate_bytes
+from creaturegen.spec.character import Genetics
 from creaturegen.surface.skeleton import build_skeleton
 
 SEEDS = range(256)
@@ -67,7 +68,7 @@ def test_a_zero_genome_keeps_the_authored_colours() -> None:
 def test_colour_genes_stay_within_their_oklab_bounds() -> None:
     """Hue rotation, chroma scale and lightness shift measured back in OKLab, for 256 individuals."""
     bounds = {"hue": 20.0, "chroma": 0.2, "lightness": 0.06}
-    genetics = genetics_data(bounds["hue"], bounds["chroma"], bounds["lightness"])
+    genetics = genetics_data(Genetics(**bounds))
     authored = np.array([hex_to_linear(c) for c in MID])
     lab = slot_lab(authored)
     base = np.asarray(lab)
@@ -96,7 +97,7 @@ def test_colour_genes_stay_within_their_oklab_bounds() -> None:
 
 
 def test_colour_mutation_clips_into_gamut() -> None:
-    genetics = genetics_data(180.0, 0.5, 0.25)
+    genetics = genetics_data(Genetics(hue=180.0, chroma=0.5, lightness=0.25))
     lab = slot_lab(np.array([hex_to_linear(c) for c in ["#ff0000", "#00ff00", "#0000ff", "#ffffff"]]))
     for seed in SEEDS:
         rgb = np.asarray(genome_colours(genetics, lab, draw_genome(seed)))

@@ -24,6 +24,7 @@ import numpy as np
 import numpy.typing as npt
 
 from ..motion.trig import pcos, psin
+from ..spec.character import Genetics
 from .pose import lcg_next, mix_seed
 
 #: Draw index (1-based) of each gene; the gait genes follow GAIT_DRAW in gene-list order.
@@ -132,9 +133,9 @@ def genome_colours(genetics: dict[str, Any], lab: list[list[float]], genome: Gen
     return out
 
 
-def genetics_data(hue_deg: float, chroma: float, lightness: float) -> dict[str, float]:
-    """The plan's colour genetics (the hue bound in radians, as the runtime uses it)."""
-    return {"hueRad": math.radians(hue_deg), "chroma": chroma, "lightness": lightness}
+def genetics_data(genetics: Genetics) -> dict[str, float]:
+    """The plan's colour genetics (the hue bound in radians, as the runtime reads it)."""
+    return {"hueRad": math.radians(genetics.hue), "chroma": genetics.chroma, "lightness": genetics.lightness}
 
 
 def express_gait(motion: dict[str, Any], genome: Genome) -> dict[str, Any]:

@@ -93,7 +93,7 @@ def build_plan(
         "roundCone": [int(x) for x in slot_uses_round_cone(rig.slots)],
         "lcg": {"a": LCG_A, "c": LCG_C},
         # Colour genes mutate these OKLab coordinates of the authored colours (creature/genome.py).
-        "genetics": genetics_data(spec.genetics.hue, spec.genetics.chroma, spec.genetics.lightness),
+        "genetics": genetics_data(spec.genetics),
         "slotLab": slot_lab(rig.slots[:, col.RGB]),
         "motion": motion,
         "tickRate": motion["hz"],

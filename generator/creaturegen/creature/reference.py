@@ -64,9 +64,8 @@ def instance_motion(
 
 def instance_colours(ref: PackageReference, seed: int) -> list[list[float]]:
     """Per-slot linear rgb of the individual spawned from ``seed`` (its colour genes in OKLab)."""
-    g = ref.spec.genetics
     lab = slot_lab(ref.rig.slots[:, col.RGB])
-    return genome_colours(genetics_data(g.hue, g.chroma, g.lightness), lab, draw_genome(seed))
+    return genome_colours(genetics_data(ref.spec.genetics), lab, draw_genome(seed))
 
 
 def field_at(ref: PackageReference, table: F64, points: F64) -> FieldSample:
