@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import json
 from functools import cache
 from pathlib import Path
 
@@ -12,12 +11,14 @@ import pytest
 from conftest import EXAMPLES
 from creaturegen.candidates import CandidateSet, TierRejectedError, build_candidates, tolerances
 from creaturegen.candidates.bounds import leaf_bounds, subtree_info
-from creaturegen.candidates.envelope import part_excursions, slot_excursions
+from creaturegen.candidates.envelope import slot_excursions
 from creaturegen.candidates.program import build_program
 from creaturegen.field.floors import floors_for
 from creaturegen.field.sampler import sample_graph
+from creaturegen.motion.envelope import pose_envelope
 from creaturegen.rig import CompiledRig, compile_rig
-from creaturegen.spec import CharacterSpec, load_spec, validate_bytes
+from creaturegen.spec import CharacterSpec, load_spec
+from creaturegen.surface.deform import posed_slots
 
 CREATURES = [p for p in sorted(EXAMPLES.rglob("*.json")) if "frost" not in p.parts]
 
@@ -117,38 +118,17 @@ def test_a_rigid_creature_fits_the_distant_tier() -> None:
     assert found.k_used <= 4
 
 
-def test_envelope_follows_declared_excursions_and_parents() -> None:
-    data = {
-        "name": "Env",
-        "parts": [
-            {"id": "body", "shape": "capsule", "a": [0, 0.5, 0], "b": [0, 0.9, 0], "r": 0.2},
-            {
-                "id": "leg",
-                "shape": "leg",
-                "parent": "body",
-                "hip": [0.1, 0, 0],
-                "upper": 0.3,
-                "lower": 0.2,
-                "r": 0.05,
-            },
-            {
-                "id": "wing",
-                "shape": "cone",
-                "parent": "body",
-                "a": [0.1, 0.2, 0],
-                "b": [0.5, 0.2, 0],
-                "r": 0.05,
-                "r2": 0.02,
-                "flap": 0.5,
-            },
-            {"id": "tuft", "shape": "sphere", "parent": "wing", "offset": [0.4, 0, 0], "r": 0.03},
-        ],
-        "scale": 2,
-    }
-    spec = validate_bytes(json.dumps(data).encode())
-    assert isinstance(spec, CharacterSpec)
-    e = part_excursions(spec)
-    assert e["body"] == 0.0
-    assert e["leg"] == pytest.approx(2 * 0.5)
-    assert e["wing"] == pytest.approx(2 * 2 * 0.4 * np.sin(0.25))
-    assert e["tuft"] == e["wing"]  # children ride on their parent
+def test_the_sweep_reads_the_motion_and_the_certificates_contain_it() -> None:
+    """The candidate sweep evaluates the programs at the motion's own poses, and every slot of those poses
+    lies inside the excursion ball the certificates assumed (tests/test_motion_envelope.py checks
+    individuals the envelope never stepped)."""
+    spec, rig = _compiled(EXAMPLES / "reference" / "quadruped.json")
+    found = _hero(EXAMPLES / "reference" / "quadruped.json")
+    env = pose_envelope(spec, rig)
+    assert found.sweep.motion_poses == len(env.poses) > 0
+    excursion = slot_excursions(spec, rig)
+    for pose in env.poses:
+        moved = np.linalg.norm(posed_slots(rig.slots, pose)[:, 0:3] - rig.slots[:, 0:3], axis=1)
+        assert np.all(moved <= excursion + 1e-12)
+    tail = [s for s, part in enumerate(rig.slot_parts) if part == "tail"]
+    assert excursion[tail[-1]] > excursion[tail[0]] > 0.0, "a tail's tip swings furthest"

@@ -5,9 +5,10 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 from ..field.floors import floors_for
+from ..motion.envelope import pose_envelope
 from ..rig import CompiledRig
 from ..spec import CharacterSpec
-from .envelope import part_excursions, slot_excursions
+from .envelope import slot_excursions
 from .program import CandidateProgram, Certificate
 from .regions import TIERS, Tier, TierRejectedError, Tolerances, search
 from .sweep import SweepResult, run_sweep
@@ -72,9 +73,11 @@ def build_candidates(spec: CharacterSpec, rig: CompiledRig, tier: str) -> Candid
     """Programs for every region, certified and swept; TierRejectedError names what could not be bounded."""
     chosen = TIERS[tier]
     tol = tolerances(rig)
-    found = search(rig, slot_excursions(spec, rig), chosen, tol)
+    excursion = slot_excursions(spec, rig)
+    found = search(rig, excursion, chosen, tol)
     programs = found.programs
-    result = run_sweep(rig, programs, part_excursions(spec), tol.band, tol.k_floor)
+    motion_poses = pose_envelope(spec, rig).poses
+    result = run_sweep(rig, programs, excursion, motion_poses, tol.band, tol.k_floor)
     gates = (
         Gate("surfaceError", result.surface_error, "m", tol.tail),
         Gate("normalAngle", result.normal_angle_deg, "deg", MAX_NORMAL_ANGLE_DEG),
@@ -115,7 +118,11 @@ def describe_candidates(spec: CharacterSpec, rig: CompiledRig, tiers: tuple[str,
             "skippedOutside": found.skipped_outside,
             "skippedInside": found.skipped_inside,
             "certificates": kinds,
-            "sweep": {"poses": found.sweep.poses, "points": found.sweep.points},
+            "sweep": {
+                "poses": found.sweep.poses,
+                "motionPoses": found.sweep.motion_poses,
+                "points": found.sweep.points,
+            },
             "gates": [
                 {
                     "name": g.name,

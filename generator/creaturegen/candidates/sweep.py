@@ -1,7 +1,9 @@
-"""Acceptance sweep: candidate programs against the full graph over sampled envelope poses.
+"""Acceptance sweep: candidate programs against the full graph over the motion's poses and the envelope.
 
-Certificates prove what they can; the sweep measures what a user would see. Each pose translates every
-part rigidly by a random vector inside its envelope ball (the same envelope the certificates assume).
+Certificates prove what they can; the sweep measures what a user would see. The poses are the rest pose,
+the representative poses of the creature's measured motion (motion/envelope.py: real ticks of real gait,
+hop, flap and swim cycles, modulo rigid body motion), and random poses that translate every slot by a
+random vector inside its excursion ball (the envelope the certificates assume).
 Sample points start uniform in each region and take two Newton steps toward the full field's zero set;
 points that leave their region or the band τ are dropped. Measured per point: |Δd|, the angle between
 the normals, the omitted leaves' share of the colour weight, and the OKLab distance of the colours.
@@ -22,12 +24,14 @@ from ..field.sampler import sample_graph
 from ..rig import CompiledRig
 from ..rig.colour import linear_to_oklab
 from ..rig.graph import BlendGraph
+from ..surface.deform import Pose, posed_slots
 from .program import CandidateProgram
 
 
 @dataclass(frozen=True)
 class SweepResult:
-    poses: int
+    poses: int  # random envelope poses
+    motion_poses: int  # poses of the measured motion
     points: int  # in-band samples evaluated, all poses together
     surface_error: float  # max |d_program − d_full|, m
     normal_angle_deg: float
@@ -35,15 +39,14 @@ class SweepResult:
     delta_e_oklab: float
 
 
-def _pose(rig: CompiledRig, part_excursion: dict[str, float], rng: np.random.Generator) -> np.ndarray:
+def _pose(rig: CompiledRig, excursion: np.ndarray, rng: np.random.Generator) -> np.ndarray:
+    """Every slot translated by its own random vector, uniform in its excursion ball."""
     slots = rig.slots.copy()
-    for part in sorted(set(rig.slot_parts)):
-        rows = [i for i, p in enumerate(rig.slot_parts) if p == part]
-        direction = rng.normal(size=3)
-        direction /= np.linalg.norm(direction)
-        shift = direction * part_excursion[part] * rng.uniform() ** (1 / 3)
-        slots[rows, col.A] += shift
-        slots[rows, col.B] += shift
+    direction = rng.normal(size=(rig.slot_count, 3))
+    direction /= np.linalg.norm(direction, axis=1, keepdims=True)
+    shift = direction * (excursion * rng.uniform(size=rig.slot_count) ** (1 / 3))[:, None]
+    slots[:, col.A] += shift
+    slots[:, col.B] += shift
     return slots
 
 
@@ -58,7 +61,8 @@ def _groups(programs: list[CandidateProgram]) -> dict[tuple[tuple[int, ...], Ble
 def run_sweep(
     rig: CompiledRig,
     programs: list[CandidateProgram],
-    part_excursion: dict[str, float],
+    excursion: np.ndarray,
+    motion_poses: tuple[Pose, ...],
     band: float,
     k_floor: float,
     poses: int = 6,
@@ -72,8 +76,9 @@ def run_sweep(
     groups = _groups(programs)
     worst = np.zeros(4)
     total = 0
-    for pose in range(poses + 1):
-        slots = rig.slots if pose == 0 else _pose(rig, part_excursion, rng)
+    tables = [rig.slots, *(posed_slots(rig.slots, pose) for pose in motion_poses)]
+    tables += [_pose(rig, excursion, rng) for _ in range(poses)]
+    for slots in tables:
         p = rng.uniform(lo[region], hi[region])
         for _ in range(2):
             f = sample_graph(rig.graph, slots, p, k_floor)
@@ -99,4 +104,4 @@ def run_sweep(
             delta_e = np.linalg.norm(linear_to_oklab(full.color[idx]) - linear_to_oklab(mine.color), axis=1)
             error = np.abs(mine.distance - full.distance[idx])
             worst = np.maximum(worst, [error.max(), angle.max(), share.max(), delta_e.max()])
-    return SweepResult(poses, total, *(float(x) for x in worst))
+    return SweepResult(poses, len(motion_poses), total, *(float(x) for x in worst))

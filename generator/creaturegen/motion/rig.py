@@ -131,6 +131,9 @@ def build_motion(spec: CharacterSpec, rig: CompiledRig, skeleton: Skeleton) -> d
                 "radius": radius,
                 "segment": segment,
                 "bendMin": 2.0 * segment * math.cos(math.radians(ROPE_BEND_LIMIT_DEG) / 2.0),
+                # The follow-the-leader pass's cone (simulate.py _follow): cosine and sine of the limit.
+                "bendCos": math.cos(math.radians(ROPE_BEND_LIMIT_DEG)),
+                "bendSin": math.sin(math.radians(ROPE_BEND_LIMIT_DEG)),
             }
         )
     wings = []

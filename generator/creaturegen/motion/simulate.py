@@ -419,6 +419,54 @@ class Motion:
                 cur[j - 1] = [a[0] + dx * hf, a[1] + dy * hf, a[2] + dz * hf]
                 cur[j + 1] = [b[0] - dx * hf, b[1] - dy * hf, b[2] - dz * hf]
 
+    def _follow(self, cur: list[Vec], before: Vec, rope: dict[str, Any], frame: Frame) -> None:
+        """Follow the leader from the anchor: each segment its rest length and within the bend limit of the
+        one before (the first of the body's direction into the anchor), and above the support. Relaxation
+        passes alone leave a whipped tail stretched and bent past its limit; the skin is certified for the
+        poses this bounds (motion/envelope.py)."""
+        seg, c_max, s_max, radius = rope["segment"], rope["bendCos"], rope["bendSin"], rope["radius"]
+        a = cur[0]
+        px, py, pz = a[0] - before[0], a[1] - before[1], a[2] - before[2]
+        n = math.sqrt(px * px + py * py + pz * pz)
+        px, py, pz = px / n, py / n, pz / n
+        for j in range(1, len(cur)):
+            a, b = cur[j - 1], cur[j]
+            ux, uy, uz = b[0] - a[0], b[1] - a[1], b[2] - a[2]
+            dist = math.sqrt(ux * ux + uy * uy + uz * uz)
+            if dist == 0.0:
+                ux, uy, uz = px, py, pz
+            else:
+                ux, uy, uz = ux / dist, uy / dist, uz / dist
+            c = ux * px + uy * py + uz * pz
+            if c < c_max:
+                wx, wy, wz = ux - c * px, uy - c * py, uz - c * pz
+                wn = math.sqrt(wx * wx + wy * wy + wz * wz)
+                if wn == 0.0:
+                    ux, uy, uz = px, py, pz
+                else:
+                    ux = c_max * px + s_max * (wx / wn)
+                    uy = c_max * py + s_max * (wy / wn)
+                    uz = c_max * pz + s_max * (wz / wn)
+            cur[j] = [a[0] + seg * ux, a[1] + seg * uy, a[2] + seg * uz]
+            if self.data["ropeGround"]:
+                x = to_local(frame, cur[j])
+                if x[1] < radius[j]:
+                    # Lift the node onto the support at radius height, swinging the segment about its
+                    # first node so its length holds (the bend may open past the limit there).
+                    o = to_local(frame, a)
+                    dy = min(seg, max(-seg, radius[j] - o[1]))
+                    dx, dz = x[0] - o[0], x[2] - o[2]
+                    flat = math.sqrt(dx * dx + dz * dz)
+                    wide = math.sqrt(max(seg * seg - dy * dy, 0.0))
+                    if flat == 0.0:
+                        dx, dz = wide, 0.0
+                    else:
+                        dx, dz = dx * (wide / flat), dz * (wide / flat)
+                    cur[j] = to_world(frame, [o[0] + dx, o[1] + dy, o[2] + dz])
+                    b = cur[j]
+                    ux, uy, uz = (b[0] - a[0]) / seg, (b[1] - a[1]) / seg, (b[2] - a[2]) / seg
+            px, py, pz = ux, uy, uz
+
     def _ropes(self, frame: Frame, integrate: bool) -> None:
         d, c = self.d, self.data["constants"]
         if not integrate:
@@ -468,6 +516,7 @@ class Motion:
                                 u, h, w = to_local(frame, cur[j])
                                 if h < radius[j]:
                                     cur[j] = to_world(frame, [u, radius[j], w])
+                    self._follow(cur, before, rope, frame)
             local = [self.to_local_root(self.root, x) for x in cur]
             rest = rope["rest"]
             # Segment frames by parallel transport down the chain (each turns by the bend from the one

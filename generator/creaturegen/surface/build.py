@@ -20,6 +20,7 @@ import numpy.typing as npt
 from .. import __version__
 from ..candidates import TierRejectedError, build_candidates
 from ..field import layout as col
+from ..motion.envelope import pose_envelope
 from ..rig import CompiledRig
 from ..rig.signatures import signatures as rig_signatures
 from ..spec import CharacterSpec
@@ -176,13 +177,16 @@ def correction_sweep(
     skeleton: Skeleton,
     choice: deform.DeformationChoice,
     programs: npt.NDArray[np.int64],
+    motion_poses: tuple[deform.Pose, ...] = (),
 ) -> tuple[npt.NDArray[np.bool_], CorrectionReport, float, F64]:
-    """Region policy and correction over the sweep's extreme poses, measured on each joint's seam.
+    """Region policy and correction over each joint's extreme sweep poses and the motion's own poses.
 
-    The region is every seam vertex whose skinned position misses the posed field by more than
-    SKIN_ERROR_FACTOR·L in some pose of its joint; each pose is then corrected over the region's seam
-    vertices that have a candidate program (the caller gates those that have none) and the worst report
-    kept. Returns (region, worst report, worst skin-only seam error in m, per-vertex trust radius).
+    A joint's extremes (its sweep limits, one joint turned) are measured on its seam. The motion's poses
+    (motion/envelope.py: whole-body poses of real cycles, every joint turned at once) are measured on
+    every seam vertex. The region is every vertex whose skinned position misses the posed field by more
+    than SKIN_ERROR_FACTOR·L in some pose; each pose is then corrected over the region's vertices it
+    measured that have a candidate program (the caller gates those that have none) and the worst report
+    kept. Returns (region, worst report, worst skin-only error in m, per-vertex trust radius).
     """
     owner = weights[0][:, 0]
     radius = np.maximum(rig.slots[owner, col.RA], rig.slots[owner, col.RB])
@@ -192,14 +196,17 @@ def correction_sweep(
     posed = []
     worst_skin = 0.0
     extremes = [
-        (child, pose)
-        for _, child in skeleton.joints
+        (seam(skeleton, weights, joint.child), pose)
+        for joint in choice.joints
         for _, pose in deform.sweep_poses(
-            skeleton, rig.slots, child, choice.bend_max_deg, choice.twist_max_deg, steps=1
+            skeleton, rig.slots, joint.child, joint.bend_max_deg, joint.twist_max_deg, steps=1
         )
     ]
-    for child, pose in extremes:
-        on_seam = seam(skeleton, weights, child)
+    any_seam = np.zeros(mesh.vertex_count, dtype=bool)
+    for joint in choice.joints:
+        any_seam |= seam(skeleton, weights, joint.child)
+    extremes += [(any_seam, pose) for pose in motion_poses]
+    for on_seam, pose in extremes:
         if not on_seam.any():
             continue
         skinned = deform.skin(
@@ -409,8 +416,22 @@ def build_surface(
         _fail_on(list(weights.gates), f"surface {tier} skin weights")
 
     t = time.perf_counter()
+    envelope = pose_envelope(spec, rig)
+    progress(
+        f"motion envelope: {len(envelope.runs)} runs × {envelope.ticks} ticks "
+        f"({envelope.samples:,} poses measured)"
+    )
     choice = deform.choose_deformation(
-        mesh, weights.indices, weights.weights, rest_field, skeleton, rig.slots, rig.graph, rig.body_scale
+        mesh,
+        weights.indices,
+        weights.weights,
+        rest_field,
+        skeleton,
+        rig.slots,
+        rig.graph,
+        rig.body_scale,
+        limits={j.child: envelope.sweep_limits(j.child) for j in envelope.joints},
+        limits_from="motion envelope (motion/envelope.py), widened by its margins",
     )
     timings["deformation"] = time.perf_counter() - t
     for joint in choice.joints:
@@ -431,7 +452,7 @@ def build_surface(
     t = time.perf_counter()
     programs, candidate_note = candidate_index(spec, rig, tier, mesh.vertices)
     region, report, worst_skin, trust = correction_sweep(
-        rig, mesh, ex.normals, (weights.indices, weights.weights), skeleton, choice, programs
+        rig, mesh, ex.normals, (weights.indices, weights.weights), skeleton, choice, programs, envelope.poses
     )
     timings["correction"] = time.perf_counter() - t
     correction_gates = [
@@ -516,6 +537,7 @@ def build_surface(
             "splitRoots": list(policy.split_roots),
             "detached": list(policy.detached),
         },
+        "motionEnvelope": envelope.describe(),
         "deformation": choice.describe(),
         "correction": {
             **report.as_dict(),

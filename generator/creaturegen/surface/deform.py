@@ -28,7 +28,7 @@ from __future__ import annotations
 import itertools
 import math
 import time
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from typing import Final, Literal
 
@@ -67,8 +67,9 @@ METHODS: Final[tuple[Method, ...]] = ("lbs", "dq", "cor")
 # often more for DQ than for LBS), so a gate would reject every method; the correction pass checks
 # inversions where they matter.
 
-#: Default sweep limits (degrees) until the real motion envelope replaces them, and angle steps per
-#: sweep direction (bend: ±e1, ±e2 about the pivot; twist: ± about the child's rest tangent).
+#: Sweep limits (degrees) of a joint the caller gives no limits for (the build gives every joint the
+#: limits of the measured motion envelope, motion/envelope.py), and angle steps per sweep direction
+#: (bend: ±e1, ±e2 about the pivot; twist: ± about the child's rest tangent).
 BEND_MAX_DEG: Final = 60.0
 TWIST_MAX_DEG: Final = 45.0
 SWEEP_STEPS: Final = 3
@@ -678,6 +679,8 @@ class JointChoice:
     scale: float  # s_j = max(r_j, pivot → nearest seam vertex), m: the unit of the joint's gates
     seam_vertices: int  # vertices weighted across the joint (the measured set)
     sweeps: tuple[MethodSweep, ...]  # every method measured, in preference order
+    bend_max_deg: float  # the limits this joint was swept to
+    twist_max_deg: float
 
     @property
     def gates(self) -> tuple[SurfaceGate, ...]:
@@ -693,6 +696,8 @@ class JointChoice:
             "radius": self.radius,
             "scale": self.scale,
             "seam_vertices": self.seam_vertices,
+            "bend_max_deg": self.bend_max_deg,
+            "twist_max_deg": self.twist_max_deg,
             "sweeps": [s.describe() for s in self.sweeps],
         }
 
@@ -704,15 +709,13 @@ class DeformationChoice:
     joints: tuple[JointChoice, ...]
     methods: tuple[Method, ...]  # per slot: its joint's method; roots "lbs"
     centers: F64  # (V, 3) CoR centres, for :func:`skin` where a joint chose "cor"
-    bend_max_deg: float
-    twist_max_deg: float
+    limits: str  # where the joints' sweep limits came from
     steps: int
     seconds: float
 
     def describe(self) -> dict[str, object]:
         return {
-            "bend_max_deg": self.bend_max_deg,
-            "twist_max_deg": self.twist_max_deg,
+            "limits": self.limits,
             "steps": self.steps,
             "seconds": self.seconds,
             "methods": list(self.methods),
@@ -1064,12 +1067,17 @@ def choose_deformation(
     twist_max_deg: float = TWIST_MAX_DEG,
     steps: int = SWEEP_STEPS,
     centers: F64 | None = None,
+    limits: Mapping[int, tuple[float, float]] | None = None,
+    limits_from: str = "",
 ) -> DeformationChoice:
     """Sweep every joint with every method and keep, per joint, the first method that passes every gate.
 
     Raises :class:`DeformationError` for the first joint no method can carry. ``field_rest`` is the rest
     body the mesh was extracted from; its slots must be ``rig_slots``. ``centers`` (from
-    :func:`centers_of_rotation`) are computed when not given.
+    :func:`centers_of_rotation`) are computed when not given. ``limits`` maps a joint's child slot to its
+    (bend, twist) sweep limits in degrees (the measured motion envelope, motion/envelope.py); a joint not
+    in it is swept to ``bend_max_deg`` and ``twist_max_deg``. A joint swept to zero never turns: every
+    method reproduces it exactly and the cheapest is kept.
     """
     start = time.perf_counter()
     idx, w = _as_arrays(indices, weights)
@@ -1093,7 +1101,8 @@ def choose_deformation(
     methods: list[Method] = ["lbs"] * len(skeleton.parent)
     joints = []
     for parent, child in skeleton.joints:
-        poses = sweep_poses(skeleton, rig_slots, child, bend_max_deg, twist_max_deg, steps)
+        bend, twist = (limits or {}).get(child, (bend_max_deg, twist_max_deg))
+        poses = sweep_poses(skeleton, rig_slots, child, bend, twist, steps)
         result = _joint_sweep(rest, idx, w, skeleton, rig_slots, graph, length_scale, child, poses)
         sweeps = result.sweeps
         chosen = next((s.method for s in sweeps if s.passed), None)
@@ -1111,14 +1120,16 @@ def choose_deformation(
                 result.scale,
                 result.seam_vertices,
                 sweeps,
+                bend,
+                twist,
             )
         )
+    where = limits_from or f"every joint {bend_max_deg:g}° bend, {twist_max_deg:g}° twist"
     return DeformationChoice(
         tuple(joints),
         tuple(methods),
         rest.centers,
-        bend_max_deg,
-        twist_max_deg,
+        where,
         steps,
         time.perf_counter() - start,
     )

@@ -56,7 +56,7 @@ def surface_settings(tier: str) -> dict[str, object]:
 
 #: Packages whose code shapes the surface: any edit to them is a different compiler, so a stale cache
 #: entry is never served while the version number stands still during development.
-SOURCE_PACKAGES = ("surface", "field", "rig", "candidates")
+SOURCE_PACKAGES = ("surface", "field", "rig", "candidates", "motion", "creature")
 
 
 @cache

@@ -93,6 +93,7 @@ export function createMotion(data, lcg, { support = createFlatGround(), gravity 
   const anchorLocal = new Float64Array(3);
   const anchorWorld = new Float64Array(3);
   const beforeWorld = new Float64Array(3);
+  const ropeLocal = new Float64Array(6); // follow(): the node, then the node before it, support-local
   const localNodes = new Float64Array(3 * Math.max(1, ...m.ropes.map((r) => r.rest.length)));
   const e0 = new Float64Array(3);
   const hinge1 = new Float64Array(3);
@@ -491,6 +492,48 @@ export function createMotion(data, lcg, { support = createFlatGround(), gravity 
     }
   }
 
+  // Follow the leader from the anchor (motion/simulate.py _follow): each segment its rest length and
+  // within the bend limit of the one before (the first of the body's direction into the anchor), and
+  // above the support, lifted by swinging the segment about its first node so its length holds.
+  function follow(cur, count, rope) {
+    const seg = rope.segment, cMax = rope.bendCos, sMax = rope.bendSin, radius = rope.radius;
+    let px = cur[0] - beforeWorld[0], py = cur[1] - beforeWorld[1], pz = cur[2] - beforeWorld[2];
+    const n = Math.sqrt(px * px + py * py + pz * pz);
+    px = px / n; py = py / n; pz = pz / n;
+    for (let j = 1; j < count; j++) {
+      const a = 3 * (j - 1), b = 3 * j;
+      let ux = cur[b] - cur[a], uy = cur[b + 1] - cur[a + 1], uz = cur[b + 2] - cur[a + 2];
+      const dist = Math.sqrt(ux * ux + uy * uy + uz * uz);
+      if (dist === 0) { ux = px; uy = py; uz = pz; } else { ux = ux / dist; uy = uy / dist; uz = uz / dist; }
+      const c = ux * px + uy * py + uz * pz;
+      if (c < cMax) {
+        const wx = ux - c * px, wy = uy - c * py, wz = uz - c * pz;
+        const wn = Math.sqrt(wx * wx + wy * wy + wz * wz);
+        if (wn === 0) { ux = px; uy = py; uz = pz; } else {
+          ux = cMax * px + sMax * (wx / wn);
+          uy = cMax * py + sMax * (wy / wn);
+          uz = cMax * pz + sMax * (wz / wn);
+        }
+      }
+      cur[b] = cur[a] + seg * ux; cur[b + 1] = cur[a + 1] + seg * uy; cur[b + 2] = cur[a + 2] + seg * uz;
+      if (m.ropeGround) {
+        toLocal(frame, cur, b, ropeLocal, 0);
+        if (ropeLocal[1] < radius[j]) {
+          toLocal(frame, cur, a, ropeLocal, 3);
+          const dy = Math.min(seg, Math.max(-seg, radius[j] - ropeLocal[4]));
+          let dx = ropeLocal[0] - ropeLocal[3], dz = ropeLocal[2] - ropeLocal[5];
+          const flat = Math.sqrt(dx * dx + dz * dz);
+          const wide = Math.sqrt(Math.max(seg * seg - dy * dy, 0));
+          if (flat === 0) { dx = wide; dz = 0; } else { dx = dx * (wide / flat); dz = dz * (wide / flat); }
+          ropeLocal[0] = ropeLocal[3] + dx; ropeLocal[1] = ropeLocal[4] + dy; ropeLocal[2] = ropeLocal[5] + dz;
+          toWorld(frame, ropeLocal, 0, cur, b);
+          ux = (cur[b] - cur[a]) / seg; uy = (cur[b + 1] - cur[a + 1]) / seg; uz = (cur[b + 2] - cur[a + 2]) / seg;
+        }
+      }
+      px = ux; py = uy; pz = uz;
+    }
+  }
+
   function ropes(integrate) {
     const c = m.constants;
     if (!integrate) {
@@ -552,6 +595,7 @@ export function createMotion(data, lcg, { support = createFlatGround(), gravity 
               }
             }
           }
+          follow(cur, count, rope);
         }
       }
       for (let j = 0; j < count; j++) toLocalRoot(root, cur, 3 * j, localNodes, 3 * j);

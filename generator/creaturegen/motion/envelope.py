@@ -1,0 +1,344 @@
+"""The pose envelope: the poses the locomotion reference reaches, measured for the sweeps that certify a body.
+
+The candidate sweep and the skinning sweeps used to assume poses (random translations inside a ball
+per part, ±60° bends and ±45° twists at every joint). Here the poses come from the creature's own
+motion: the Python reference (motion/simulate.py, bit for bit what the package's core runs) is stepped
+over whole cycles for the authored individual and every corner of the gait-gene box (each gene at −1
+and +1, the bounds every spawned genome lies within), on every built-in support a walker or hopper can
+be given, at four headings where the support is not the same in every direction (the swimmer on the
+analytic water a population uses by default).
+
+Poses are taken modulo the body's rigid motion, in the frame of the first skeleton root: one rigid
+transform of every slot changes no distance, normal or weight (the flyer's bank and the swimmer's yaw
+wave turn the whole body). What remains is what skinning and candidate programs must carry: per joint,
+the child's rotation relative to its parent, split into swing (bend of the child's rest tangent) and
+twist (about it); per slot, how far its ends move from rest.
+
+Sampled corners are not a proof: an individual between them, or at another heading, can go a little
+further (ropes are chaotic). The consumers widen what was measured by stated margins, and
+tests/test_motion_envelope.py checks randomly spawned individuals on every support against the widened
+envelope.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import itertools
+import json
+import math
+import os
+from dataclasses import dataclass
+from functools import cache
+from typing import Any, Final
+
+import numpy as np
+import numpy.typing as npt
+
+from ..creature.genome import MAX_GAIT_GENES, Genome
+from ..creature.pose import instance_yaw
+from ..field import layout as col
+from ..rig import CompiledRig
+from ..spec import CharacterSpec
+from ..surface.asset import default_cache_root
+from ..surface.deform import Pose, joint_frame, quaternion_multiply, quaternion_to_matrix
+from ..surface.identity import source_digest
+from ..surface.skeleton import Skeleton, build_skeleton
+from .derived import derive
+from .providers import AnalyticWater, FlatGround, Gravity, Support, builtin_supports
+from .rig import WALKERS, build_motion
+from .simulate import Motion
+
+F64 = npt.NDArray[np.float64]
+
+#: Whole cycles stepped per run (walkers: gait cycles; hopper: hops; flyer: flaps; swimmer: undulation
+#: periods), and the least time a run covers: ropes settle from rest and first steps start from the
+#: initial plant, and both are poses a spawned instance shows.
+CYCLES: Final = 2
+MIN_SECONDS: Final = 4.0
+#: Poses of the envelope handed to the whole-body sweeps (candidate programs, skin correction), chosen
+#: by farthest-point selection over all sampled ticks, starting from the pose that moves slots most.
+SWEEP_POSES: Final = 8
+#: What the consumers add to the measured envelope: a slot's excursion ball is SLOT_MARGIN times its
+#: largest measured displacement; a joint that turns at all (more than STILL_DEG, float noise) is swept
+#: JOINT_SLACK_DEG past its measured bend and twist. Individuals between the sampled corners, other
+#: headings and rope chaos go a little past the corners (tests/test_motion_envelope.py measures random
+#: spawns against the widened envelope on every support); the render pose interpolates between ticks.
+SLOT_MARGIN: Final = 1.25
+JOINT_SLACK_DEG: Final = 10.0
+STILL_DEG: Final = 1e-3
+#: Headings a run starts at on a support that is not the same in every direction.
+HEADINGS: Final = 4
+
+
+@dataclass(frozen=True)
+class JointEnvelope:
+    """Worst rotation of one joint's child relative to its parent over every run."""
+
+    child: int
+    bend_deg: float  # swing of the child's rest tangent
+    twist_deg: float  # about the child's rest tangent
+    pivot_drift: float  # |relative transform moves the pivot|, m: a joint turns about its pivot
+
+
+@dataclass(frozen=True)
+class PoseEnvelope:
+    runs: tuple[str, ...]  # "support genome" labels of the runs stepped
+    ticks: int  # ticks per run
+    samples: int  # poses measured, all runs together
+    joints: tuple[JointEnvelope, ...]  # in skeleton.joints order
+    slot_displacement: F64  # (S,) max |posed end − rest end|, m, in the root frame
+    poses: tuple[Pose, ...]  # SWEEP_POSES representative poses, root frame
+    pose_labels: tuple[str, ...]
+
+    def joint(self, child: int) -> JointEnvelope | None:
+        return next((j for j in self.joints if j.child == child), None)
+
+    def sweep_limits(self, child: int) -> tuple[float, float]:
+        """(bend, twist) in degrees the skinning sweep of the joint above ``child`` must reach."""
+        j = self.joint(child)
+        if j is None:
+            return 0.0, 0.0
+        widen = [a + JOINT_SLACK_DEG if a > STILL_DEG else 0.0 for a in (j.bend_deg, j.twist_deg)]
+        return widen[0], widen[1]
+
+    @property
+    def slot_excursion(self) -> F64:
+        """(S,) the radius, m, each slot's ends may move from rest: the widened measured displacement."""
+        result: F64 = SLOT_MARGIN * self.slot_displacement
+        return result
+
+    def describe(self) -> dict[str, object]:
+        return {
+            "runs": list(self.runs),
+            "ticksPerRun": self.ticks,
+            "samples": self.samples,
+            "sweepPoses": list(self.pose_labels),
+            "margins": {"slot": SLOT_MARGIN, "jointSlackDeg": JOINT_SLACK_DEG, "stillDeg": STILL_DEG},
+            "slotDisplacement": self.slot_displacement.tolist(),
+            "joints": [
+                {
+                    "child": j.child,
+                    "bendDeg": j.bend_deg,
+                    "twistDeg": j.twist_deg,
+                    "pivotDrift": j.pivot_drift,
+                }
+                for j in self.joints
+            ],
+        }
+
+
+def run_ticks(data: dict[str, Any]) -> int:
+    """Ticks per run: CYCLES of the creature's own period, and at least MIN_SECONDS."""
+    d = derive(data, Gravity().at(0.0))
+    kind = data["type"]
+    period = 0
+    if kind in WALKERS:
+        period = d.cycle
+    elif kind == "hopper":
+        period = d.hop_cycle
+    elif kind == "flyer" and d.flap_hz > 0.0:
+        period = math.ceil(d.hz / d.flap_hz)
+    elif kind == "swimmer" and d.undulation_hz > 0.0:
+        period = math.ceil(d.hz / d.undulation_hz)
+    return max(CYCLES * period, math.ceil(MIN_SECONDS * d.hz))
+
+
+def corner_genomes(data: dict[str, Any]) -> list[tuple[str, Genome]]:
+    """The authored genome and every corner of the gait-gene box (colour genes move no slot)."""
+    count = len(data["genes"]["fields"])
+    out = [("authored", Genome(0.0, 0.0, 0.0, (0.0,) * MAX_GAIT_GENES))]
+    if data["genes"]["jitter"] > 0.0:
+        for signs in itertools.product((-1.0, 1.0), repeat=count):
+            label = "genes " + "".join("+" if s > 0 else "-" for s in signs)
+            out.append((label, Genome(0.0, 0.0, 0.0, (*signs, *[0.0] * (MAX_GAIT_GENES - count)))))
+    return out
+
+
+@cache
+def heading_seeds() -> tuple[int, ...]:
+    """Spawn seeds whose heading is nearest 0°, 90°, 180° and 270° (a seed fixes the heading): on a slope
+    or a moving platform the legs work differently uphill, downhill and across."""
+    seeds = []
+    for k in range(HEADINGS):
+        target = 2.0 * math.pi * k / HEADINGS
+        seeds.append(
+            min(
+                range(4096),
+                key=lambda s: abs((instance_yaw(s) - target + math.pi) % (2.0 * math.pi) - math.pi),
+            )
+        )
+    return tuple(seeds)
+
+
+def envelope_runs(data: dict[str, Any]) -> list[tuple[str, Motion]]:
+    """Every genome corner on every support the creature can be given, at every heading where the
+    support is not the same in all directions."""
+    runs = []
+    for (support_name, support), (genome_name, genome) in itertools.product(
+        envelope_supports(data).items(), corner_genomes(data)
+    ):
+        seeds = heading_seeds()[:1] if support_name == "flat" else heading_seeds()
+        for seed in seeds:
+            motion = individual(data, support, seed, genome)
+            heading = round(math.degrees(instance_yaw(seed)))
+            runs.append((f"{support_name} {genome_name} heading {heading}°", motion))
+    return runs
+
+
+def envelope_supports(data: dict[str, Any]) -> dict[str, Support]:
+    """The built-in supports for a creature that stands on one, else flat ground (never consulted)."""
+    kind = data["type"]
+    return builtin_supports() if kind in WALKERS or kind == "hopper" else {"flat": FlatGround()}
+
+
+def individual(data: dict[str, Any], support: Support, seed: int, genome: Genome | None = None) -> Motion:
+    """The individual spawned from ``seed`` (its genome unless one is given) on ``support``; a swimmer
+    on the analytic water."""
+    water = AnalyticWater() if data["type"] == "swimmer" else None
+    return Motion(data, support=support, water=water, genome=genome, seed=seed)
+
+
+def _record(
+    data: dict[str, Any], runs: list[tuple[str, Motion]]
+) -> tuple[list[str], int, F64, F64, list[str]]:
+    """(run labels, ticks per run, quaternions (N, S, 4) wxyz, translations (N, S, 3), sample labels)."""
+    ticks = run_ticks(data)
+    labels, quats, trans, sample_labels = [], [], [], []
+    for label, motion in runs:
+        labels.append(label)
+        for tick in range(ticks + 1):
+            if tick:
+                motion.step()
+            quats.append([[q[3], q[0], q[1], q[2]] for q in motion.quats])
+            trans.append([list(t) for t in motion.trans])
+            sample_labels.append(f"{label} tick {tick}")
+    return labels, ticks, np.asarray(quats), np.asarray(trans), sample_labels
+
+
+def _root_frame(quats: F64, trans: F64, root: int) -> tuple[F64, F64]:
+    """Every slot's transform composed with the inverse of ``root``'s: the pose modulo rigid motion."""
+    inverse = quats[:, root : root + 1] * np.array([1.0, -1.0, -1.0, -1.0])
+    q = quaternion_multiply(np.broadcast_to(inverse, quats.shape), quats)
+    r_inv = quaternion_to_matrix(inverse)
+    t = np.einsum(
+        "nsij,nsj->nsi", np.broadcast_to(r_inv, (*quats.shape[:2], 3, 3)), trans - trans[:, root : root + 1]
+    )
+    return q, t
+
+
+def _joint(skeleton: Skeleton, rest: F64, q: F64, t: F64, parent: int, child: int) -> JointEnvelope:
+    """Swing and twist of the child relative to its parent at every sample; the worst of each."""
+    inverse = q[:, parent] * np.array([1.0, -1.0, -1.0, -1.0])
+    rel = quaternion_multiply(inverse, q[:, child])
+    rel = np.where(rel[:, :1] < 0.0, -rel, rel)
+    tangent, _, _ = joint_frame(skeleton, rest, child)
+    along = rel[:, 1:] @ tangent
+    twist = 2.0 * np.arctan2(np.abs(along), rel[:, 0])
+    turned = np.einsum("nij,j->ni", quaternion_to_matrix(rel), tangent)
+    bend = np.arccos(np.clip(turned @ tangent, -1.0, 1.0))
+    # The pivot carried by the child's transform and by the parent's must coincide.
+    pivot = skeleton.pivot[child]
+    by_child = np.einsum("nij,j->ni", quaternion_to_matrix(q[:, child]), pivot) + t[:, child]
+    by_parent = np.einsum("nij,j->ni", quaternion_to_matrix(q[:, parent]), pivot) + t[:, parent]
+    drift = np.linalg.norm(by_child - by_parent, axis=1)
+    return JointEnvelope(
+        child, float(np.degrees(bend.max())), float(np.degrees(twist.max())), float(drift.max())
+    )
+
+
+def _farthest(points: F64, count: int, first: int) -> list[int]:
+    chosen = [first]
+    gap = np.linalg.norm(points - points[first], axis=1)
+    while len(chosen) < min(count, len(points)):
+        nxt = int(np.argmax(gap))
+        if gap[nxt] <= 0.0:
+            break
+        chosen.append(nxt)
+        gap = np.minimum(gap, np.linalg.norm(points - points[nxt], axis=1))
+    return chosen
+
+
+def measure_envelope(
+    data: dict[str, Any], rest: F64, skeleton: Skeleton, runs: list[tuple[str, Motion]] | None = None
+) -> PoseEnvelope:
+    """Step every run (by default :func:`envelope_runs`), measure every joint and slot, and pick the
+    whole-body sweep poses."""
+    labels, ticks, quats, trans, sample_labels = _record(data, envelope_runs(data) if runs is None else runs)
+    root = int(data["roots"][0])
+    q, t = _root_frame(quats, trans, root)
+    joints = tuple(_joint(skeleton, rest, q, t, p, c) for p, c in skeleton.joints)
+    rot = quaternion_to_matrix(q)
+    ends = []
+    for end in (col.A, col.B):
+        posed = np.einsum("nsij,sj->nsi", rot, rest[:, end]) + t
+        ends.append(posed - rest[:, end])
+    moved = np.concatenate(ends, axis=2)  # (N, S, 6)
+    displacement = np.maximum(np.linalg.norm(ends[0], axis=2), np.linalg.norm(ends[1], axis=2)).max(axis=0)
+    flat = moved.reshape(len(moved), -1)
+    picked = _farthest(flat, SWEEP_POSES, int(np.argmax(np.linalg.norm(flat, axis=1))))
+    poses = tuple(Pose(rot[n], t[n]) for n in picked)
+    return PoseEnvelope(
+        tuple(labels),
+        ticks,
+        len(q),
+        joints,
+        displacement,
+        poses,
+        tuple(sample_labels[n] for n in picked),
+    )
+
+
+def _to_json(env: PoseEnvelope) -> str:
+    return json.dumps(
+        {
+            "runs": env.runs,
+            "ticks": env.ticks,
+            "samples": env.samples,
+            "joints": [[j.child, j.bend_deg, j.twist_deg, j.pivot_drift] for j in env.joints],
+            "slotDisplacement": env.slot_displacement.tolist(),
+            "poses": [[p.rotations.tolist(), p.translations.tolist()] for p in env.poses],
+            "labels": env.pose_labels,
+        }
+    )
+
+
+def _from_json(text: str) -> PoseEnvelope:
+    raw = json.loads(text)
+    return PoseEnvelope(
+        tuple(raw["runs"]),
+        int(raw["ticks"]),
+        int(raw["samples"]),
+        tuple(JointEnvelope(int(c), b, t, d) for c, b, t, d in raw["joints"]),
+        np.asarray(raw["slotDisplacement"], dtype=np.float64),
+        tuple(
+            Pose(np.asarray(r, dtype=np.float64), np.asarray(t, dtype=np.float64)) for r, t in raw["poses"]
+        ),
+        tuple(raw["labels"]),
+    )
+
+
+_MEMORY: dict[str, PoseEnvelope] = {}
+
+
+def pose_envelope(spec: CharacterSpec, rig: CompiledRig) -> PoseEnvelope:
+    """The envelope of ``spec``'s motion. Stepping every run takes seconds and the candidate stage, the
+    surface stage and the plan all ask, so it is kept in memory and on disk beside the surface cache,
+    keyed by the motion data, the rest slots and the generator's sources (floats round-trip exactly)."""
+    skeleton = build_skeleton(spec, rig)
+    data = build_motion(spec, rig, skeleton)
+    key = hashlib.sha256(
+        json.dumps(data, sort_keys=True).encode() + rig.slots.tobytes() + source_digest().encode()
+    ).hexdigest()
+    if key in _MEMORY:
+        return _MEMORY[key]
+    path = default_cache_root() / "envelope" / f"{key}.json"
+    if path.is_file():
+        envelope = _from_json(path.read_text())
+    else:
+        envelope = measure_envelope(data, rig.slots, skeleton)
+        path.parent.mkdir(parents=True, exist_ok=True)
+        staging = path.with_suffix(f".{os.getpid()}.tmp")
+        staging.write_text(_to_json(envelope))
+        staging.replace(path)
+    _MEMORY[key] = envelope
+    return envelope
