@@ -11,7 +11,6 @@ import pytest
 from conftest import EXAMPLES
 from creaturegen.candidates import CandidateSet, TierRejectedError, build_candidates, tolerances
 from creaturegen.candidates.bounds import leaf_bounds, subtree_info
-from creaturegen.candidates.envelope import slot_excursions
 from creaturegen.candidates.program import build_program
 from creaturegen.field.floors import floors_for
 from creaturegen.field.sampler import sample_graph
@@ -55,7 +54,7 @@ def test_an_uncertified_omission_is_flagged_and_really_changes_the_field() -> No
     head = rig.slot_parts.index("head")
     centre = rig.slots[head, 0:3]
     lo, hi = centre - 0.1, centre + 0.1
-    excursion = slot_excursions(spec, rig)
+    excursion = pose_envelope(spec, rig).slot_excursion
     bounds = leaf_bounds(rig.slots, excursion, lo, hi)
     tol = tolerances(rig)
     kept = set(range(rig.slot_count)) - {head}
@@ -126,7 +125,7 @@ def test_the_sweep_reads_the_motion_and_the_certificates_contain_it() -> None:
     found = _hero(EXAMPLES / "reference" / "quadruped.json")
     env = pose_envelope(spec, rig)
     assert found.sweep.motion_poses == len(env.poses) > 0
-    excursion = slot_excursions(spec, rig)
+    excursion = env.slot_excursion
     for pose in env.poses:
         moved = np.linalg.norm(posed_slots(rig.slots, pose)[:, 0:3] - rig.slots[:, 0:3], axis=1)
         assert np.all(moved <= excursion + 1e-12)

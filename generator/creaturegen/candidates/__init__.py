@@ -8,7 +8,6 @@ from ..field.floors import floors_for
 from ..motion.envelope import pose_envelope
 from ..rig import CompiledRig
 from ..spec import CharacterSpec
-from .envelope import slot_excursions
 from .program import CandidateProgram, Certificate
 from .regions import TIERS, Tier, TierRejectedError, Tolerances, search
 from .sweep import SweepResult, run_sweep
@@ -73,11 +72,10 @@ def build_candidates(spec: CharacterSpec, rig: CompiledRig, tier: str) -> Candid
     """Programs for every region, certified and swept; TierRejectedError names what could not be bounded."""
     chosen = TIERS[tier]
     tol = tolerances(rig)
-    excursion = slot_excursions(spec, rig)
-    found = search(rig, excursion, chosen, tol)
+    envelope = pose_envelope(spec, rig)
+    found = search(rig, envelope.slot_excursion, chosen, tol)
     programs = found.programs
-    motion_poses = pose_envelope(spec, rig).poses
-    result = run_sweep(rig, programs, excursion, motion_poses, tol.band, tol.k_floor)
+    result = run_sweep(rig, programs, envelope.slot_excursion, envelope.poses, tol.band, tol.k_floor)
     gates = (
         Gate("surfaceError", result.surface_error, "m", tol.tail),
         Gate("normalAngle", result.normal_angle_deg, "deg", MAX_NORMAL_ANGLE_DEG),

@@ -14,6 +14,12 @@ wave turn the whole body). What remains is what skinning and candidate programs 
 the child's rotation relative to its parent, split into swing (bend of the child's rest tangent) and
 twist (about it); per slot, how far its ends move from rest.
 
+The candidate certificates assume each slot moves at most its widened displacement (``slot_excursion``).
+This replaced a model assumed before locomotion existed (a leg's whole reach, a rope's length, a flap's
+chord, a squash ratio, inherited down the parts), which the measured motion broke: a rope tail swings its
+tip up to twice its length from rest. The hopper's squash is the root transform's, applied after the
+field, skin and correction, so it moves no slot.
+
 Sampled corners are not a proof: an individual between them, or at another heading, can go a little
 further (ropes are chaotic). The consumers widen what was measured by stated margins, and
 tests/test_motion_envelope.py checks randomly spawned individuals on every support against the widened

@@ -195,16 +195,15 @@ def correction_sweep(
     region = np.zeros(mesh.vertex_count, dtype=bool)
     posed = []
     worst_skin = 0.0
+    seams = {joint.child: seam(skeleton, weights, joint.child) for joint in choice.joints}
     extremes = [
-        (seam(skeleton, weights, joint.child), pose)
+        (seams[joint.child], pose)
         for joint in choice.joints
         for _, pose in deform.sweep_poses(
             skeleton, rig.slots, joint.child, joint.bend_max_deg, joint.twist_max_deg, steps=1
         )
     ]
-    any_seam = np.zeros(mesh.vertex_count, dtype=bool)
-    for joint in choice.joints:
-        any_seam |= seam(skeleton, weights, joint.child)
+    any_seam = np.logical_or.reduce([*seams.values(), np.zeros(mesh.vertex_count, dtype=bool)])
     extremes += [(any_seam, pose) for pose in motion_poses]
     for on_seam, pose in extremes:
         if not on_seam.any():

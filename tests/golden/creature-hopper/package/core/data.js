@@ -2885,7 +2885,7 @@ export const CREATURE = Object.freeze({
     0
   ],
   "signatures": {
-    "compilerSignature": "2f18458d815d7d3025003e20623cde5adf946e70e7bf330023bad24668a53053",
+    "compilerSignature": "8c1b8e24f86126e35b2ab0375ec0a414a7f211677bfac1d51a4acc75ad3bb79d",
     "geometryDigest": "400b0d18a2a9f6bbbfe5b441f89767f552a4f3b4c45a368d1129d632e1d2f4f1",
     "topologySignature": "5dc1330d82638a76baa5a5e186b089ecf086f1e0e101eb660242231ce0bbb29d"
   },
