@@ -23,6 +23,9 @@ LAB_PORT ?= 8765
 # Extra pytest arguments for local runs, e.g. PYTEST_ARGS='-k smoke'. CI leaves it empty: every test
 # runs, browser-marked ones included, and "no tests collected" (exit 5) fails like any other error.
 PYTEST_ARGS ?=
+# pytest-xdist workers. Two fill a 2-core CI machine: much of the suite waits on Chromium, node and
+# subprocess builds, and the workers share one surface cache and one package folder (tests/conftest.py).
+PYTEST_WORKERS ?= 2
 # Only folders that exist: git does not keep empty ones, and ruff fails on a missing path.
 LINT_PATHS := $(wildcard generator tests bench)
 
@@ -114,7 +117,7 @@ test: setup
 	@echo "==> mypy"
 	$(VENV)/bin/mypy generator
 	@echo "==> pytest"
-	$(VENV_PY) -m pytest $(PYTEST_ARGS)
+	$(VENV_PY) -m pytest -n $(PYTEST_WORKERS) $(PYTEST_ARGS)
 
 # --- housekeeping -----------------------------------------------------------------------------
 

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import contextlib
+import fcntl
 import importlib
 import importlib.util
 import os
@@ -39,11 +41,34 @@ def repo() -> Path:
     return REPO
 
 
+def shared_folder(factory: pytest.TempPathFactory, name: str) -> Path:
+    """A folder for the whole run. Under pytest-xdist (``make test`` runs two workers) each worker has a
+    base temp of its own, and their parent is the run's: the workers share the folder there, so an example
+    is extracted and packaged once per run, not once per worker."""
+    if os.environ.get("PYTEST_XDIST_WORKER"):
+        folder = factory.getbasetemp().parent / name
+        folder.mkdir(exist_ok=True)
+        return folder
+    return factory.mktemp(name)
+
+
+@contextlib.contextmanager
+def held(lock: Path) -> Iterator[None]:
+    """An exclusive advisory lock on ``lock`` (created): one worker at a time past this point."""
+    with lock.open("a") as handle:
+        fcntl.flock(handle, fcntl.LOCK_EX)
+        try:
+            yield
+        finally:
+            fcntl.flock(handle, fcntl.LOCK_UN)
+
+
 @pytest.fixture(scope="session", autouse=True)
 def surface_cache_root(tmp_path_factory: pytest.TempPathFactory) -> Iterator[str]:
-    """One surface cache for the whole session, also seen by CLI children through $CREATUREGEN_CACHE:
-    every example is extracted once, whichever test builds it first (surface, package or parity)."""
-    root = str(tmp_path_factory.mktemp("surface-cache"))
+    """One surface cache for the whole run, also seen by CLI children through $CREATUREGEN_CACHE:
+    every example is extracted once, whichever test (or worker) builds it first (surface, package or
+    parity); SurfaceCache.building makes a second worker wait for the first one's entry."""
+    root = str(shared_folder(tmp_path_factory, "surface-cache"))
     previous = os.environ.get("CREATUREGEN_CACHE")
     os.environ["CREATUREGEN_CACHE"] = root
     yield root
@@ -68,21 +93,25 @@ def no_build_pictures() -> Iterator[None]:
 
 @pytest.fixture(scope="session")
 def creature_out(tmp_path_factory: pytest.TempPathFactory) -> Path:
-    """One output folder for example packages, shared by every test that needs a built creature."""
-    return tmp_path_factory.mktemp("creature-out")
+    """One output folder for example packages, shared by every test (and worker) that needs a built
+    creature."""
+    return shared_folder(tmp_path_factory, "creature-out")
 
 
 def build_example(name: str, out_root: Path) -> Path:
-    """examples/<name> built through the command line into ``out_root`` (once per session)."""
+    """examples/<name> built through the command line into ``out_root`` (once per run: a worker that
+    finds another one building it waits, then uses its package)."""
     import json
 
     from creaturegen.spec import slugify
 
     spec = EXAMPLES / name
-    package = out_root / slugify(json.loads(spec.read_text())["name"])
-    if not package.exists():
-        result = run_cli("build", str(spec), "-o", str(out_root))
-        assert result.returncode == 0, result.stdout[-2000:] + result.stderr[-4000:]
+    slug = slugify(json.loads(spec.read_text())["name"])
+    package = out_root / slug
+    with held(out_root / f".{slug}.lock"):
+        if not package.exists():
+            result = run_cli("build", str(spec), "-o", str(out_root))
+            assert result.returncode == 0, result.stdout[-2000:] + result.stderr[-4000:]
     return package
 
 

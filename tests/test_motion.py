@@ -287,9 +287,6 @@ def test_js_core_matches_python(name: str, creature_out: Path, tmp_path: Path) -
     print(f"{name}: " + "; ".join(re.findall(r"^\S+ seed \d+: worst .*$", done.stdout, re.M)))
 
 
-#: The swimmer's water provider takes plain numbers (sample(x, z, time, out)), which V8 boxes when the call
-#: is not inlined: printed, not gated, until the provider interface passes arrays. Every other type is gated.
-ALLOCATING = ("swimmer",)
 #: Heap growth allowed over the measured steps: room for the probe's own bookkeeping (a few kB), far below
 #: one boxed number per step (16 B × ALLOC_STEPS).
 ALLOC_STEPS = 5000
@@ -321,8 +318,6 @@ def test_steady_state_steps_do_not_allocate(name: str, creature_out: Path) -> No
         f"{name} ({result['type']}): {alloc['heapGrowthBytes']} bytes over {alloc['steps']} steps, "
         f"{alloc['collections']} GCs"
     )
-    if result["type"] in ALLOCATING:
-        return
     assert alloc["collections"] == 0, f"{name}: {alloc['collections']} collections in steady state"
     assert alloc["heapGrowthBytes"] < ALLOC_SLACK_BYTES, (
         f"{name}: the step allocates ({alloc['bytesPerStep']:.1f} B/step)"

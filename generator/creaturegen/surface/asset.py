@@ -45,12 +45,14 @@ sidecar records the .glb's SHA-256) reads as a miss, which the next ``store`` ov
 
 from __future__ import annotations
 
+import contextlib
 import hashlib
 import json
 import os
 import re
 import struct
 import tempfile
+from collections.abc import Iterator
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Final, cast
@@ -520,6 +522,26 @@ class SurfaceCache:
     def index_path(self, compiler: str, geometry: str, tier: str, settings_digest: str) -> Path:
         s = _check_hex(settings_digest, "settingsDigest")
         return self.geometry_folder(compiler, geometry) / f"index-{_check_tier(tier)}-{s[:PREFIX]}.json"
+
+    @contextlib.contextmanager
+    def building(self, compiler: str, geometry: str, tier: str, settings_digest: str) -> Iterator[None]:
+        """Hold the build of one lookup key: a second build of the same surface sharing this cache (another
+        process: a parallel build, a test worker) waits here, then finds the entry instead of extracting
+        it again. An advisory lock file beside the index; where the platform has no ``fcntl`` the builds
+        simply both run (entries are written atomically, so the result is the same)."""
+        path = self.index_path(compiler, geometry, tier, settings_digest).with_suffix(".lock")
+        path.parent.mkdir(parents=True, exist_ok=True)
+        try:
+            import fcntl
+        except ImportError:  # pragma: no cover (not POSIX)
+            yield
+            return
+        with path.open("a") as handle:
+            fcntl.flock(handle, fcntl.LOCK_EX)
+            try:
+                yield
+            finally:
+                fcntl.flock(handle, fcntl.LOCK_UN)
 
     def lookup(self, compiler: str, geometry: str, tier: str, settings_digest: str) -> CachedSurface | None:
         """The stored surface for this key, or ``None`` (missing, mismatched or corrupt: all misses)."""

@@ -385,7 +385,10 @@ def build_surface(
     compiler = identity.compiler_signature(rig, tier, extra)
     geometry = rig_signatures(rig).geometryDigest
     settings = identity.settings_digest(tier, extra)
-    if cache is not None:
+    key = _Key(geometry, settings, extra)
+    if cache is None:
+        return _extract_surface(spec, rig, key, tier, backend, None, progress, strict)
+    with cache.building(compiler, geometry, tier, settings):
         hit: CachedSurface | None = cache.lookup(compiler, geometry, tier, settings)
         if hit is not None:
             progress(f"cache hit {hit.folder}")
@@ -393,7 +396,30 @@ def build_surface(
             return SurfaceBuild(
                 tier, dict(_sig_rows(hit.sidecar)), hit.asset, hit.sidecar, cached, True, hit.folder
             )
+        return _extract_surface(spec, rig, key, tier, backend, cache, progress, strict)
 
+
+@dataclass(frozen=True)
+class _Key:
+    """What the cold path needs of the lookup key (the compilerSignature is recomputed with the rest)."""
+
+    geometry: str
+    settings: str
+    extra: dict[str, object]
+
+
+def _extract_surface(
+    spec: CharacterSpec,
+    rig: CompiledRig,
+    key: _Key,
+    tier: str,
+    backend: str,
+    cache: SurfaceCache | None,
+    progress: Progress,
+    strict: bool,
+) -> SurfaceBuild:
+    """Extract, gate, weight, choose deformations and correct: the cold path of build_surface."""
+    geometry, settings, extra = key.geometry, key.settings, key.extra
     t0 = time.perf_counter()
     chosen, why = choose_backend(rig, backend, progress)
     rest_field = BodyField(rig.graph, rig.slots)

@@ -98,7 +98,10 @@ def trust_radius(rest: Mesh, rest_normals: F64, bound_radius: F64) -> F64:
     return result
 
 
-def _inverted_vertices(faces: npt.NDArray[np.int32], positions: F64, field: BodyField) -> B:
+def _inverted_vertices(faces: npt.NDArray[np.int32], positions: F64, moved: B, field: BodyField) -> B:
+    """Vertices of triangles that touch a moved vertex and face against the field normal. Only those
+    fans can have changed, so only they pay a field evaluation (the rest are the skin's own triangles)."""
+    faces = faces[np.any(moved[faces], axis=1)]
     c = positions[faces]
     n = np.cross(c[:, 1] - c[:, 0], c[:, 2] - c[:, 0])
     g = field.gradient(c.mean(axis=1))
@@ -168,8 +171,8 @@ def correct(
     out = skinned.copy()
     out[idx[accept]] = p[accept]
     # The full check over each fan: any vertex of an inverted triangle falls back to its skinned place.
-    inverted = _inverted_vertices(rest.faces, out, field) & region
-    inverted &= np.any(out != skinned, axis=1)
+    moved = np.any(out != skinned, axis=1)
+    inverted = _inverted_vertices(rest.faces, out, moved, field) & region & moved
     out[inverted] = skinned[inverted]
     final = np.abs(field.distance(out[idx]) - iso) if idx.size else np.zeros(0)
     kept = np.any(out[idx] != skinned[idx], axis=1)

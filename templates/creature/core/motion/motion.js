@@ -83,6 +83,7 @@ export function createMotion(data, lcg, { support = createFlatGround(), gravity 
   const target = new Float64Array(3);
   const hopOut = new Float64Array(3);
   const path = new Float64Array(3);
+  const query = new Float64Array(3); // the water query (x, z, time): numbers in an array are never boxed
   const locals = new Float64Array(4 * S);
   const hasLocal = new Uint8Array(S);
   const turned = new Float64Array(3);
@@ -257,7 +258,8 @@ export function createMotion(data, lcg, { support = createFlatGround(), gravity 
     const time = n * d.dt;
     dist1[0] = m.speed * time;
     pathAt(dist1, path);
-    water.sample(path[0], path[1], time, sample);
+    query[0] = path[0]; query[1] = path[1]; query[2] = time;
+    water.sample(query, sample);
     const eta = sample.freeSurfacePoint[1];
     const tgt = eta - d.swimDepth - m.centreY;
     const tv = sample.geometricNormalVelocityMps[0] / sample.freeSurfaceNormal[1];

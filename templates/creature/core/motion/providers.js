@@ -115,7 +115,8 @@ export function builtinSupports() {
 const WAVE_CHANNELS = ['freeSurfacePoint', 'geometricNormalVelocityMps', 'freeSurfaceNormal', 'waterColumnDepthMeters'];
 
 /** Two travelling sine waves, η = A1 sin(k1 x − w1 t) + A2 sin(k2 z − w2 t + 0.7). `channels` lists what
- * it represents; sample() writes only those into `out` (one Float64Array per channel). */
+ * it represents; sample(query, out) reads (x, z, time) from `query` and writes only those channels into `out`
+ * (one Float64Array per channel). */
 export function createAnalyticWater({
   channels = WAVE_CHANNELS, waves = [[0.06, 1.3, 1.7], [0.04, 0.9, 1.1]], level = 0, depth = 4,
 } = {}) {
@@ -127,7 +128,8 @@ export function createAnalyticWater({
     createSample() {
       return { freeSurfacePoint: new Float64Array(3), freeSurfaceNormal: new Float64Array(3), geometricNormalVelocityMps: new Float64Array(1), waterColumnDepthMeters: new Float64Array(1) };
     },
-    sample(x, z, time, out) {
+    sample(query, out) {
+      const x = query[0], z = query[1], time = query[2];
       t1[2] = k1 * x - w1 * time;
       t2[2] = k2 * z - w2 * time + 0.7;
       sincos(t1, 2, t1, 0);

@@ -2885,7 +2885,7 @@ export const CREATURE = Object.freeze({
     0
   ],
   "signatures": {
-    "compilerSignature": "8c1b8e24f86126e35b2ab0375ec0a414a7f211677bfac1d51a4acc75ad3bb79d",
+    "compilerSignature": "7c06147372765e7e4fd443a7aae900420eb20dc56ee08db4b6384c76c1ddf1bf",
     "geometryDigest": "400b0d18a2a9f6bbbfe5b441f89767f552a4f3b4c45a368d1129d632e1d2f4f1",
     "topologySignature": "5dc1330d82638a76baa5a5e186b089ecf086f1e0e101eb660242231ce0bbb29d"
   },

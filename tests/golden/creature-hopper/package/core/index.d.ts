@@ -52,7 +52,9 @@ export type WaterChannel = 'freeSurfacePoint' | 'freeSurfaceNormal' | 'geometric
 export interface WaterSurfaceProvider {
   readonly channels: readonly WaterChannel[];
   createSample(): Record<string, Float64Array>;
-  sample(x: number, z: number, time: number, out: Record<string, Float64Array>): Record<string, Float64Array>;
+  /** `query` holds (x, z, time): world x and z in metres and sim time in seconds, in an array so a step passes
+   * no boxed number. Writes the listed channels into `out` and returns it. */
+  sample(query: ArrayLike<number>, out: Record<string, Float64Array>): Record<string, Float64Array>;
 }
 
 export interface Driver {
