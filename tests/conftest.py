@@ -2,8 +2,6 @@
 
 from __future__ import annotations
 
-import contextlib
-import fcntl
 import importlib
 import importlib.util
 import os
@@ -17,6 +15,8 @@ from types import ModuleType
 from typing import Any
 
 import pytest
+
+from creaturegen.surface.asset import exclusive
 
 REPO = Path(__file__).resolve().parents[1]
 EXAMPLES = REPO / "examples"
@@ -50,17 +50,6 @@ def shared_folder(factory: pytest.TempPathFactory, name: str) -> Path:
         folder.mkdir(exist_ok=True)
         return folder
     return factory.mktemp(name)
-
-
-@contextlib.contextmanager
-def held(lock: Path) -> Iterator[None]:
-    """An exclusive advisory lock on ``lock`` (created): one worker at a time past this point."""
-    with lock.open("a") as handle:
-        fcntl.flock(handle, fcntl.LOCK_EX)
-        try:
-            yield
-        finally:
-            fcntl.flock(handle, fcntl.LOCK_UN)
 
 
 @pytest.fixture(scope="session", autouse=True)
@@ -108,7 +97,7 @@ def build_example(name: str, out_root: Path) -> Path:
     spec = EXAMPLES / name
     slug = slugify(json.loads(spec.read_text())["name"])
     package = out_root / slug
-    with held(out_root / f".{slug}.lock"):
+    with exclusive(out_root / f".{slug}.lock"):
         if not package.exists():
             result = run_cli("build", str(spec), "-o", str(out_root))
             assert result.returncode == 0, result.stdout[-2000:] + result.stderr[-4000:]

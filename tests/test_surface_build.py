@@ -10,6 +10,8 @@ from __future__ import annotations
 
 import hashlib
 import os
+import subprocess
+import sys
 from functools import cache
 from pathlib import Path
 
@@ -131,6 +133,30 @@ def test_cli_build_is_byte_identical_across_backends_and_caches(tmp_path: Path) 
     assert digests[0] == digests[1] == digests[2]
     glb = (tmp_path / "out-0" / "hopper-squash-core" / "assets" / "surface.glb").read_bytes()
     assert parse_glb(glb).positions.shape[1] == 3
+
+
+def test_two_builds_sharing_a_cache_extract_once(tmp_path: Path) -> None:
+    """Two `creaturegen build` processes started together on one spec and one cold cache: one extracts,
+    the other waits on SurfaceCache.building and takes the entry (what lets the test workers share a
+    cache), and both write the same package."""
+    env = {**os.environ, "CREATUREGEN_CACHE": str(tmp_path / "cache")}
+    spec = str(EXAMPLES / "reference" / "hopper.json")
+    runs = [
+        subprocess.Popen(
+            [sys.executable, "-m", "creaturegen.cli", "build", spec, "-o", str(tmp_path / f"out-{n}")],
+            stdout=subprocess.PIPE,
+            stderr=subprocess.PIPE,
+            text=True,
+            env=env,
+        )
+        for n in range(2)
+    ]
+    outputs = [run.communicate(timeout=600) for run in runs]
+    assert [run.returncode for run in runs] == [0, 0], outputs
+    logs = [out + err for out, err in outputs]
+    assert sorted("cache hit" in log for log in logs) == [False, True], "expected one extraction, one hit"
+    digests = {_package_digest(tmp_path / f"out-{n}" / "hopper-squash-core") for n in range(2)}
+    assert len(digests) == 1
 
 
 def test_cli_inspect_prints_the_surface_gates() -> None:

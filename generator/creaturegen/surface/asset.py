@@ -489,6 +489,23 @@ def _read_json(path: Path) -> dict[str, Any] | None:
     return value if isinstance(value, dict) else None
 
 
+@contextlib.contextmanager
+def exclusive(lock: Path) -> Iterator[None]:
+    """An exclusive advisory lock on the file ``lock`` (created if missing): one process at a time past
+    this point. Without ``fcntl`` (not POSIX) it lets everyone through."""
+    try:
+        import fcntl
+    except ImportError:  # pragma: no cover (not POSIX)
+        yield
+        return
+    with lock.open("a") as handle:
+        fcntl.flock(handle, fcntl.LOCK_EX)
+        try:
+            yield
+        finally:
+            fcntl.flock(handle, fcntl.LOCK_UN)
+
+
 @dataclass(frozen=True)
 class CachedSurface:
     asset: SurfaceAsset
@@ -531,17 +548,8 @@ class SurfaceCache:
         simply both run (entries are written atomically, so the result is the same)."""
         path = self.index_path(compiler, geometry, tier, settings_digest).with_suffix(".lock")
         path.parent.mkdir(parents=True, exist_ok=True)
-        try:
-            import fcntl
-        except ImportError:  # pragma: no cover (not POSIX)
+        with exclusive(path):
             yield
-            return
-        with path.open("a") as handle:
-            fcntl.flock(handle, fcntl.LOCK_EX)
-            try:
-                yield
-            finally:
-                fcntl.flock(handle, fcntl.LOCK_UN)
 
     def lookup(self, compiler: str, geometry: str, tier: str, settings_digest: str) -> CachedSurface | None:
         """The stored surface for this key, or ``None`` (missing, mismatched or corrupt: all misses)."""

@@ -2885,7 +2885,7 @@ export const CREATURE = Object.freeze({
     0
   ],
   "signatures": {
-    "compilerSignature": "7c06147372765e7e4fd443a7aae900420eb20dc56ee08db4b6384c76c1ddf1bf",
+    "compilerSignature": "5bbf6c2eea5d54b822a5138873c4657fa4b5bc63621606f3f8a684ec7b9ffb39",
     "geometryDigest": "400b0d18a2a9f6bbbfe5b441f89767f552a4f3b4c45a368d1129d632e1d2f4f1",
     "topologySignature": "5dc1330d82638a76baa5a5e186b089ecf086f1e0e101eb660242231ce0bbb29d"
   },
