@@ -429,12 +429,12 @@ def python_reference(spec_path: Path) -> dict[str, Any]:
                 motion.step()
             rows = np.concatenate(
                 [
-                    pose_module.pose_rows(rig, motion.quats, motion.trans, colours).ravel(),
-                    pose_module.root_rows(motion.root).ravel(),
+                    pose_module.pose_rows(rig, motion.quats, motion.trans, colours, motion.size).ravel(),
+                    pose_module.root_rows(motion.root, size=motion.size).ravel(),
                 ]
             )
             frames.append({"tick": tick, "root": list(motion.root), "rowBits": rows.view(np.uint32).tolist()})
-        cases.append({"seed": seed, "frames": frames})
+        cases.append({"seed": seed, "size": motion.size, "frames": frames})
     return {
         "slotCount": rig.slot_count,
         "constants": {

@@ -133,14 +133,35 @@ def test_the_job_catches_a_deform_pre_pass_that_skips_the_correction(out_root: P
         "deform.js",
         [
             (
-                "...recordInputs(records, v), base, skinOnly, colour: true",
-                "...recordInputs(records, v), base, skinOnly: true, colour: true",
+                "...recordInputs(records, v), base, size, skinOnly, colour: true",
+                "...recordInputs(records, v), base, size, skinOnly: true, colour: true",
             )
         ],
     )
     report = run_creature_parity(planted, groups=("skin",))
     failed = {g["name"] for g in report.gates if g["status"] == "fail"}
     assert failed == {"drawn vertices (deform storage) vs the GPU body path"}, report.summary()
+
+
+@pytest.mark.browser
+def test_the_job_catches_a_body_path_that_ignores_the_size(out_root: Path, tmp_path: Path) -> None:
+    """The lab's instance 0 spawns at a size other than 1 (tests/test_size.py): skinning the unscaled rest
+    mesh under the scaled pose rows fails the skinning gate against numpy."""
+    package = build("reference/hopper.json", out_root)
+    planted = _planted(
+        package,
+        tmp_path,
+        "body.js",
+        [
+            (
+                "skinVertex(rest.mul(s), base, slots, weights, skin.x, cor.mul(s))",
+                "skinVertex(rest, base, slots, weights, skin.x, cor)",
+            )
+        ],
+    )
+    report = run_creature_parity(planted, groups=("skin",))
+    failed = {g["name"] for g in report.gates if g["status"] == "fail"}
+    assert "GPU-skinned vertices vs numpy" in failed, report.summary()
 
 
 @pytest.mark.browser

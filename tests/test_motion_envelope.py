@@ -91,7 +91,7 @@ def test_ropes_keep_their_length_and_bend_limit() -> None:
     worst_len, worst_bend = 0.0, 0.0
     for _ in range(600):
         motion.step()
-        for rope, nodes in zip(data["ropes"], motion.nodes, strict=True):
+        for rope, nodes in zip(motion.data["ropes"], motion.nodes, strict=True):  # the individual's size
             seg = rope["segment"]
             dirs = [np.subtract(b, a) for a, b in itertools.pairwise(nodes)]
             worst_len = max(worst_len, max(abs(float(np.linalg.norm(d)) - seg) / seg for d in dirs))

@@ -347,7 +347,7 @@ async function main() {
       const k = 1 / Math.sqrt(root[5]);
       const out = [];
       for (let l = 0; l < legs.length; l++) {
-        const leg = legs[l];
+        const leg = motion.data.legs[l]; // the individual's leg: its size scales the rest foot the rows draw
         const o = leg.lower * data.poseRows * 4;
         const q = new Float64Array([rows[o + 12], rows[o + 13], rows[o + 14], rows[o + 15]]);
         const p = new Float64Array(3);

@@ -26,7 +26,7 @@ export interface PopulationOptions {
 }
 
 export interface SpawnOptions {
-  /** Unsigned 32-bit seed: the individual's genome (heading, colour and gait genes) from the package's LCG. */
+  /** Unsigned 32-bit seed: the individual's genome (heading, colour, gait and size genes) from the package's LCG. */
   seed?: number;
   /** Where the body's path starts; the locomotion puts it on the support, the water or at its altitude. */
   position?: [number, number, number];
@@ -43,7 +43,7 @@ export interface InstanceInfo {
   root: number[] | null;
   /** Posed world AABB: min xyz, max xyz. */
   bounds: number[];
-  /** Genes in [-1, 1): hue, chroma, lightness, then the gait genes (null when dead). */
+  /** Genes in [-1, 1): hue, chroma, lightness, the gait genes, then size (null when dead). */
   genome: number[] | null;
 }
 

@@ -55,14 +55,15 @@ test('pose rows and root rows from the motion core match the reference bit for b
   const world = new Float64Array(6);
   const p = new Float64Array(3);
   let frames = 0, minSquash = Infinity, maxSquash = -Infinity;
-  for (const { seed, frames: expected } of ref.cases) {
+  for (const { seed, size, frames: expected } of ref.cases) {
     const motion = core.createMotion(data.motion, data.lcg, { water: core.createAnalyticWater(), seed });
+    assert.equal(motion.size, size, `seed ${seed}: size`);
     const colours = core.genomeColours(data, core.drawGenome(seed, data.lcg), new Float64Array(3 * ref.slotCount));
     for (const frame of expected) {
       if (frame.tick) motion.step();
       assert.equal(motion.tick, frame.tick);
-      core.writePoseRows(data, motion.quats, motion.trans, colours, 0, tmp, page, pad, local);
-      core.writeRootRows(motion.root, 1, page, pad + rowFloats);
+      core.writePoseRows(data, motion.quats, motion.trans, colours, 0, tmp, page, pad, local, motion.size);
+      core.writeRootRows(motion.root, 1, page, pad + rowFloats, motion.size);
       for (let i = 0; i < total; i++) {
         if (bits[pad + i] !== frame.rowBits[i]) assert.fail(`seed ${seed} tick ${frame.tick}: row float ${i} is ${page[pad + i]}`);
       }

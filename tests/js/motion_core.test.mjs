@@ -69,8 +69,8 @@ test('JS core matches Python after 1000 ticks on every support surface', () => {
 });
 
 test('derived numbers match', () => {
-  // From the individual of case 0 (its gait genes scale the authored data), as Python derived them.
-  const individual = core.expressGait(data, core.drawGenome(ref.cases[0].seed, core.CREATURE.lcg));
+  // From the individual of case 0 (its size and gait genes scale the authored data), as Python derived them.
+  const individual = core.express(data, core.drawGenome(ref.cases[0].seed, core.CREATURE.lcg));
   const d = core.derive(individual, [0, -core.STANDARD_GRAVITY, 0]);
   const py = ref.cases[0].derived;
   for (const [k, v] of Object.entries(py)) {

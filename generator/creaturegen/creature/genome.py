@@ -8,8 +8,17 @@ starts at ``mix_seed(seed)`` (draw 1 is reserved, draw 2 is the heading, see pos
   only input: its OKLab coordinates are computed at build time (``slot_lab``) and shipped; the runtime
   only mutates them and converts back (cubes and 3×3 products, no cube root), so Python and JS agree bit
   for bit.
-- draws 6 onwards: one gait gene per group of the locomotion type's gene list (``motion["genes"]``), each
+- draws 6, 7, 8: one gait gene per group of the locomotion type's gene list (``motion["genes"]``), each
   scaling its parameters by ``1 + jitter·gene``; a walker's step length stays within its reach limit.
+- draw 9: size, ``1 + genes.size·gene``. Size is the one morphology gene a spawn may carry, because it is a
+  similarity: the rest geometry (slot ends, radii, blend widths; the mesh's vertices and centres of
+  rotation) and every length of the motion data scale together, so the field of an individual of size s is
+  ``s·f(x/s)`` and its skinned, corrected mesh is the certified one scaled by s, with the same connectivity,
+  the same signed Jacobians (times s³) and the same surface error relative to its own length. Gravity is
+  not scaled, so speeds scale by √s (Froude similarity: every time scales by √s and the gait keeps its
+  proportions up to whole ticks), and the build's pose envelope steps the size corners too. Proportions
+  (girth, limbs, tails) change the shape, so they are build-time identities (creature/morphology.py),
+  never a spawn.
 
 The JS core (core/genome.js) runs the same scalar arithmetic in the same order.
 """
@@ -34,6 +43,7 @@ LIGHTNESS_DRAW: Final = 5
 GAIT_DRAW: Final = 6
 #: Gait genes a type may carry (the longest gene list).
 MAX_GAIT_GENES: Final = 3
+SIZE_DRAW: Final = GAIT_DRAW + MAX_GAIT_GENES
 
 # Björn Ottosson's OKLab matrices (linear sRGB -> LMS, LMS' -> Lab, and their inverses).
 _M1: Final = (
@@ -66,6 +76,7 @@ class Genome:
     chroma: float
     lightness: float
     gait: tuple[float, ...]
+    size: float = 0.0
 
 
 def _signed(draw: int) -> float:
@@ -76,7 +87,7 @@ def draw_genome(seed: int) -> Genome:
     """The genome of the individual spawned from ``seed`` (the same draws as core/genome.js drawGenome)."""
     state = mix_seed(seed)
     draws = []
-    for _ in range(GAIT_DRAW + MAX_GAIT_GENES - 1):
+    for _ in range(SIZE_DRAW):
         state = lcg_next(state)
         draws.append(_signed(state))
     gait_from = GAIT_DRAW - 1
@@ -85,6 +96,7 @@ def draw_genome(seed: int) -> Genome:
         chroma=draws[CHROMA_DRAW - 1],
         lightness=draws[LIGHTNESS_DRAW - 1],
         gait=tuple(draws[gait_from : gait_from + MAX_GAIT_GENES]),
+        size=draws[SIZE_DRAW - 1],
     )
 
 
@@ -156,3 +168,34 @@ def express_gait(motion: dict[str, Any], genome: Genome) -> dict[str, Any]:
         for name in group:
             expressed[name] = motion[name] * factor
     return expressed
+
+
+def individual_size(motion: dict[str, Any], genome: Genome) -> float:
+    """The size factor of an individual: ``1 + genes.size·gene`` (1 when the spec's bound is 0)."""
+    return 1.0 + float(motion["genes"]["size"]) * genome.size
+
+
+def _scaled(value: Any, factor: float) -> Any:
+    return [_scaled(v, factor) for v in value] if isinstance(value, list) else value * factor
+
+
+def express_size(motion: dict[str, Any], size: float) -> dict[str, Any]:
+    """The motion data of an individual of ``size``: every length ``motion["lengths"]`` names (top-level,
+    and per leg, rope and wing) times ``size``, nested lists element by element, and every speed times
+    √size (Froude similarity, motion/rig.py SIZED_FIELDS). The authored data is not modified."""
+    names = motion["lengths"]
+    expressed = dict(motion)
+    for name in names["speeds"]:
+        expressed[name] = motion[name] * math.sqrt(size)
+    for name in names["top"]:
+        expressed[name] = _scaled(motion[name], size)
+    for group in ("legs", "ropes", "wings"):
+        expressed[group] = [
+            {**item, **{name: _scaled(item[name], size) for name in names[group]}} for item in motion[group]
+        ]
+    return expressed
+
+
+def express(motion: dict[str, Any], genome: Genome) -> dict[str, Any]:
+    """The motion data of an individual: its size first, then its gait genes (core/genome.js express)."""
+    return express_gait(express_size(motion, individual_size(motion, genome)), genome)

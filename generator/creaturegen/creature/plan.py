@@ -132,6 +132,7 @@ def build_plan(
         "usage": usage,
         # The package README's gait-gene line (each gene scales its fields together).
         "genes": "; ".join(" with ".join(g) for g in motion["genes"]["fields"]) or "nothing (no locomotion)",
+        "sizeRange": f"{1.0 - spec.genetics.size:g} to {1.0 + spec.genetics.size:g}",
         "signatures": dict(surface.signatures),
         "tier": surface.tier,
         "gates": [g.as_dict() for g in surface.gates],

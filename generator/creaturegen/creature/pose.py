@@ -7,7 +7,12 @@ rows (core/pose.js writePoseRows, the same arithmetic in the same order as ``pos
 
 - per slot, POSE_ROWS vec4: (a, ra), (b, rb), (k, rgb), quaternion xyzw, (t, roundCone), where rgb is
   the individual's colour (creature/genome.py genome_colours);
-- after the slots, two root rows: (x, y, z, alive), (cos yaw, sin yaw, squash, 0).
+- after the slots, two root rows: (x, y, z, alive), (cos yaw, sin yaw, squash, size).
+
+An individual's size s (creature/genome.py) scales its rest geometry before the slot transforms: the rows
+hold ``R(q_s)·(s·a) + t_s``, ``s·r`` and ``s·k``; the GPU scales every blend op's k (tsl/field.js) and each
+rest vertex, centre of rotation and trust radius (tsl/body.js) by the root row's size, so the drawn body
+is the certified one scaled by s.
 
 The LCG is integer arithmetic, identical in Python and JS, so the reference reproduces any spawned
 instance from its seed.
@@ -15,6 +20,7 @@ instance from its seed.
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from collections.abc import Sequence
 from typing import Final
@@ -26,6 +32,7 @@ from ..field import layout as col
 from ..field.primitives import slot_uses_round_cone
 from ..motion import quat as vq
 from ..rig import CompiledRig
+from ..rig.graph import BlendGraph
 from ..surface.deform import Pose, quaternion_to_matrix
 
 F64 = npt.NDArray[np.float64]
@@ -70,15 +77,32 @@ def as_pose(quats: Sequence[Sequence[float]], trans: Sequence[Sequence[float]]) 
     return Pose(quaternion_to_matrix(wxyz), np.asarray(trans, dtype=np.float64))
 
 
+def sized_graph(graph: BlendGraph, size: float) -> BlendGraph:
+    """The blend graph of an individual of ``size``: every op's blend width times ``size`` (the GPU scales
+    each instruction's k by the root row's size, tsl/field.js)."""
+    return dataclasses.replace(graph, ops=tuple(dataclasses.replace(op, k=op.k * size) for op in graph.ops))
+
+
+def sized_slots(slots: F64, size: float) -> F64:
+    """The slot table of an individual of ``size``: ends, radii and blend widths times ``size`` (the
+    colours are the genome's business, see genome_colours)."""
+    out = np.array(slots, dtype=np.float64, copy=True)
+    for columns in (col.A, col.RA, col.B, col.RB, col.K):
+        out[:, columns] = out[:, columns] * size
+    return out
+
+
 def pose_rows(
     rig: CompiledRig,
     quats: Sequence[Sequence[float]],
     trans: Sequence[Sequence[float]],
     colours: Sequence[Sequence[float]] | None = None,
+    size: float = 1.0,
 ) -> npt.NDArray[np.float32]:
     """(S, POSE_ROWS, 4) float32 rows of one instance's pose page entry, as the JS core writes them;
-    ``colours`` is the individual's per-slot linear rgb (creature/genome.py), else the authored one."""
-    slots = rig.slots
+    ``colours`` is the individual's per-slot linear rgb (creature/genome.py), else the authored one;
+    ``size`` its size factor (Motion.size)."""
+    slots = sized_slots(rig.slots, size)
     t = np.asarray(trans, dtype=np.float64)
     rows = np.zeros((rig.slot_count, POSE_ROWS, 4))
     for s in range(rig.slot_count):
@@ -94,8 +118,8 @@ def pose_rows(
     return rows.astype(np.float32)
 
 
-def root_rows(root: Sequence[float], alive: bool = True) -> npt.NDArray[np.float32]:
-    """(2, 4) float32 root rows: (x, y, z, alive), (cos yaw, sin yaw, squash, 0)."""
+def root_rows(root: Sequence[float], alive: bool = True, size: float = 1.0) -> npt.NDArray[np.float32]:
+    """(2, 4) float32 root rows: (x, y, z, alive), (cos yaw, sin yaw, squash, size)."""
     return np.array(
-        [[root[0], root[1], root[2], float(alive)], [root[3], root[4], root[5], 0.0]], dtype=np.float32
+        [[root[0], root[1], root[2], float(alive)], [root[3], root[4], root[5], size]], dtype=np.float32
     )

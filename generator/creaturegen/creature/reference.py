@@ -27,6 +27,7 @@ from ..surface.asset import SurfaceAsset, read_glb
 from ..surface.deform import Pose, skin_cor, skin_dq, skin_lbs
 from ..surface.skeleton import build_skeleton
 from .genome import draw_genome, genetics_data, genome_colours, slot_lab
+from .pose import sized_graph
 
 F64 = npt.NDArray[np.float64]
 
@@ -68,8 +69,10 @@ def instance_colours(ref: PackageReference, seed: int) -> list[list[float]]:
     return genome_colours(genetics_data(ref.spec.genetics), lab, draw_genome(seed))
 
 
-def field_at(ref: PackageReference, table: F64, points: F64) -> FieldSample:
-    return sample_graph(ref.rig.graph, table, points, floors_for(ref.rig.body_scale).k_floor)
+def field_at(ref: PackageReference, table: F64, points: F64, size: float = 1.0) -> FieldSample:
+    """The field of a posed slot table (of an individual of ``size``: its colour-kernel floor scales too)."""
+    graph = sized_graph(ref.rig.graph, size)
+    return sample_graph(graph, table, points, floors_for(ref.rig.body_scale).k_floor * size)
 
 
 def probe_points(table: F64, graph_pairs: list[tuple[int, int]], count: int, seed: int = 0) -> F64:
@@ -127,10 +130,11 @@ def blend_pairs(rig: CompiledRig) -> list[tuple[int, int]]:
     return pairs
 
 
-def skinned_reference(ref: PackageReference, pose: Pose) -> F64:
-    """Each vertex skinned in float64 by its baked method (LBS, DQ or CoR), as surface/deform.py does."""
+def skinned_reference(ref: PackageReference, pose: Pose, size: float = 1.0) -> F64:
+    """Each vertex skinned in float64 by its baked method (LBS, DQ or CoR), as surface/deform.py does; an
+    individual of ``size`` skins its rest vertices and centres of rotation scaled by it."""
     asset = ref.asset
-    vertices = asset.positions.astype(np.float64)
+    vertices = asset.positions.astype(np.float64) * size
     normals = asset.normals.astype(np.float64)
     indices = asset.slots.astype(np.int64)
     weights = asset.weights.astype(np.float64)
@@ -146,6 +150,6 @@ def skinned_reference(ref: PackageReference, pose: Pose) -> F64:
         elif code == 1:
             out[rows] = skin_dq(v, n, i, w, pose).positions
         else:
-            centres = np.asarray(asset.cor_centers)[rows].astype(np.float64)
+            centres = np.asarray(asset.cor_centers)[rows].astype(np.float64) * size
             out[rows] = skin_cor(v, n, i, w, pose, centres).positions
     return out

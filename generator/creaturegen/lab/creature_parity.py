@@ -18,7 +18,7 @@ Gates, all measured in the run (thresholds are relative to the body scale L wher
 - motion: the JS locomotion core in the page vs Python (relative 1e-12), and every planted foot as the GPU
   pose buffer draws it (rows read back, root squash/yaw/position applied) on its plant point;
 - genetics grid: 64 individuals (seeds 0..63) spawned in an 8×8 grid and stepped: every one's GPU pose
-  rows (its OKLab-mutated colours and the pose its gait genes give) vs its Python reference, no two
+  rows (its OKLab-mutated colours and the pose its size and gait genes give) vs its Python reference, no two
   individuals alike; parity/grid.png shows them.
 """
 
@@ -39,7 +39,7 @@ from scipy import ndimage
 
 from ..creature import reference as cref
 from ..creature.genome import slot_lab
-from ..creature.pose import POSE_ROWS, as_pose, pose_rows, root_rows
+from ..creature.pose import POSE_ROWS, as_pose, pose_rows, root_rows, sized_slots
 from ..field import layout as col
 from ..motion.simulate import Motion
 from ..surface.deform import posed_slots
@@ -164,8 +164,10 @@ def _pose_and_field_gates(
     gpu_rows = np.asarray(page.evaluate("() => window.__lab.readPose(0)"), dtype=np.float32)
     rows = np.concatenate(
         [
-            pose_rows(ref.rig, motion.quats, motion.trans, cref.instance_colours(ref, LAB_SEED)).reshape(-1),
-            root_rows(motion.root).reshape(-1),
+            pose_rows(
+                ref.rig, motion.quats, motion.trans, cref.instance_colours(ref, LAB_SEED), motion.size
+            ).reshape(-1),
+            root_rows(motion.root, size=motion.size).reshape(-1),
         ]
     )
     report.gate(
@@ -177,14 +179,15 @@ def _pose_and_field_gates(
     report.measurements["motion"] = {
         "tick": PARITY_TICK,
         "root": list(motion.root),
+        "size": motion.size,
         "gates": motion.gates.as_dict(),
     }
-    table = posed_slots(ref.rig.slots, as_pose(motion.quats, motion.trans))
+    table = posed_slots(sized_slots(ref.rig.slots, motion.size), as_pose(motion.quats, motion.trans))
     points = cref.probe_points(table, cref.blend_pairs(ref.rig), PROBE_POINTS)
     raw = page.evaluate("(p) => window.__lab.probeField(p)", points.reshape(-1).tolist())
     gpu = np.asarray(raw, dtype=np.float64).reshape(-1, 4)
-    exact = cref.field_at(ref, table, points)
-    f32 = cref.field_at(ref, table, points.astype(np.float32).astype(np.float64))
+    exact = cref.field_at(ref, table, points, motion.size)
+    f32 = cref.field_at(ref, table, points.astype(np.float32).astype(np.float64), motion.size)
     dd = np.abs(gpu[:, 0] - exact.distance) / scale
     report.gate(f"field |d_gpu - d_numpy| at {len(points)} points", float(dd.max()), DISTANCE_TOL, "L")
 
@@ -238,15 +241,15 @@ def _motion_gates(page: Page, ref: cref.PackageReference, motion: Motion, report
 def _skin_gates(page: Page, ref: cref.PackageReference, motion: Motion, report: ParityReport) -> None:
     scale = ref.rig.body_scale
     pose = as_pose(motion.quats, motion.trans)
-    table = posed_slots(ref.rig.slots, pose)
+    table = posed_slots(sized_slots(ref.rig.slots, motion.size), pose)
     got = page.evaluate("() => window.__lab.readSkinned(0)")
     skinned = _b64_floats(got["skinned"]).reshape(-1, 3).astype(np.float64)
     corrected = _b64_floats(got["corrected"]).reshape(-1, 3).astype(np.float64)
     accepted = _b64_floats(got["accepted"]) > 0.5
-    expected = cref.skinned_reference(ref, pose)
+    expected = cref.skinned_reference(ref, pose, motion.size)
     error = np.linalg.norm(skinned - expected, axis=1) / scale
     report.gate("GPU-skinned vertices vs numpy", float(error.max()), POSITION_TOL, "L")
-    field = cref.field_at(ref, table, np.concatenate([skinned, corrected]))
+    field = cref.field_at(ref, table, np.concatenate([skinned, corrected]), motion.size)
     n = skinned.shape[0]
     d_skin, d_corr = np.abs(field.distance[:n]), np.abs(field.distance[n:])
     region = np.asarray(ref.asset.skin)[:, 1] > 0
@@ -269,7 +272,7 @@ def _skin_gates(page: Page, ref: cref.PackageReference, motion: Motion, report: 
         "drawn vertices (deform storage) vs the GPU body path", float(drawn_error.max()), POSITION_TOL, "L"
     )
     drawn_distance = _b64_floats(drawn["distance"]).astype(np.float64)
-    at_drawn = cref.field_at(ref, table, drawn_position)
+    at_drawn = cref.field_at(ref, table, drawn_position, motion.size)
     report.gate(
         "drawn field distance vs numpy at the drawn vertices",
         float(np.abs(drawn_distance - at_drawn.distance).max() / scale),
@@ -337,14 +340,14 @@ def _pictures(page: Page, package: Path, debug: bool) -> None:
 def _grid_gates(page: Page, ref: cref.PackageReference, package: Path, report: ParityReport) -> None:
     """The genetics grid: each individual's GPU pose rows against the Python reference spawned from the same
     seed and position (the colour rows alone at float32 rounding, all rows relative to L), and how far the
-    individuals differ: colour (OKLab distance of the mean slot colour to the authored one) and pace."""
+    individuals differ: colour (OKLab distance of the mean slot colour to the authored one), pace and size."""
     # Not drawn at spawn: the step's one upload and deform pre-pass draws all 64.
     bodies = page.evaluate(f"() => window.__lab.grid({GRID_SIDE}, {GRID_SEED}, {GRID_SPACING}, false)")
     page.evaluate(f"() => window.__lab.stepTicks({GRID_TICK})")
     scale = ref.rig.body_scale
     slots = ref.rig.slot_count
     worst_rows = worst_colour = 0.0
-    colours, paces = [], []
+    colours, paces, sizes = [], [], []
     for body in bodies:
         gpu = np.asarray(page.evaluate(f"() => window.__lab.readPose({body['id']})"), dtype=np.float32)
         seed = int(body["seed"])
@@ -353,8 +356,8 @@ def _grid_gates(page: Page, ref: cref.PackageReference, package: Path, report: P
         mine = cref.instance_colours(ref, seed)
         rows = np.concatenate(
             [
-                pose_rows(ref.rig, motion.quats, motion.trans, mine).reshape(-1),
-                root_rows(motion.root).reshape(-1),
+                pose_rows(ref.rig, motion.quats, motion.trans, mine, motion.size).reshape(-1),
+                root_rows(motion.root, size=motion.size).reshape(-1),
             ]
         )
         got = gpu[: rows.size]
@@ -363,6 +366,7 @@ def _grid_gates(page: Page, ref: cref.PackageReference, package: Path, report: P
         worst_colour = max(worst_colour, float(np.abs(colour_rows - np.asarray(mine, np.float32)).max()))
         colours.append(colour_rows.astype(np.float64).ravel())
         paces.append(motion.data["speed"] / ref.motion["speed"] if ref.motion["speed"] > 0 else 1.0)
+        sizes.append(motion.size)
     report.gate(
         f"genome colours of {len(bodies)} individuals: GPU pose rows vs Python (OKLab mutation)",
         worst_colour,
@@ -370,7 +374,7 @@ def _grid_gates(page: Page, ref: cref.PackageReference, package: Path, report: P
         "linear rgb",
     )
     report.gate(
-        f"pose rows of {len(bodies)} individuals at tick {GRID_TICK}: GPU vs Python (gait genes)",
+        f"pose rows of {len(bodies)} individuals at tick {GRID_TICK}: GPU vs Python (size and gait genes)",
         worst_rows,
         1e-6,
         "L",
@@ -390,6 +394,7 @@ def _grid_gates(page: Page, ref: cref.PackageReference, package: Path, report: P
         "minColourGapLinear": float(gaps.min()),
         "oklabShift": {"median": float(np.median(shift)), "max": float(shift.max())},
         "pace": [float(min(paces)), float(max(paces))],
+        "size": [float(min(sizes)), float(max(sizes))],
     }
     shot = page.evaluate("() => window.__lab.capturePixels('grid')")
     write_png(package / "parity" / "grid.png", _rgba(shot))

@@ -59,10 +59,13 @@ def derive(data: dict[str, Any], gravity: list[float]) -> Derived:
         groups = data["groups"]
         # A foot lands stepLead·s ahead of home and lifts once it lags s behind: planted for
         # (1 + stepLead)·s / v seconds. The cycle is that stance plus the swing, a whole number of
-        # windows, so a steady gait lifts each group right as its window opens.
+        # windows, so a steady gait lifts each group right as its window opens. The stance is rounded
+        # up with one whole tick to spare: on the curved path the lag grows along a chord, a little
+        # slower than v·t, and a stance that filled its windows exactly missed its lift by a hair and
+        # waited a whole cycle (the quadruped at size +8% then lagged past its reach for 208 leg-ticks).
         stance = 0
         if speed > 0.0:
-            stance = math.floor((1.0 + c["stepLead"]) * data["stepLength"] / (speed * dt)) + 1
+            stance = math.floor((1.0 + c["stepLead"]) * data["stepLength"] / (speed * dt)) + 2
         window = max(swing + 1, -(-(swing + stance) // groups))
         cycle = groups * window
     half_air = max(1, ticks_from_seconds(math.sqrt(2.0 * data["hopHeight"] / g), hz))

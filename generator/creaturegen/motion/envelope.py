@@ -3,10 +3,16 @@
 The candidate sweep and the skinning sweeps used to assume poses (random translations inside a ball
 per part, ±60° bends and ±45° twists at every joint). Here the poses come from the creature's own
 motion: the Python reference (motion/simulate.py, bit for bit what the package's core runs) is stepped
-over whole cycles for the authored individual and every corner of the gait-gene box (each gene at −1
-and +1, the bounds every spawned genome lies within), on every built-in support a walker or hopper can
-be given, at four headings where the support is not the same in every direction (the swimmer on the
-analytic water a population uses by default).
+over whole cycles for the authored individual and every corner of the gene box that moves slots (each
+gait gene and the size gene at −1 and +1, the bounds every spawned genome lies within), on every built-in
+support a walker or hopper can be given, at four headings where the support is not the same in every
+direction (the swimmer on the analytic water a population uses by default).
+
+An individual of size s is a similarity of the certified body: its slot transforms carry ``s·x`` to
+``R·s·x + t``, which is the unit body's ``R·x + t/s`` scaled by s. So each sample is recorded as the unit
+body's pose (translations divided by the individual's size): what the unit body must carry so that every
+size in the box is certified by the same sweeps. Size still changes the poses themselves, because gravity
+is not scaled (swing and air times, rope sag and the flyer's bank differ).
 
 Poses are taken modulo the body's rigid motion, in the frame of the first skeleton root: one rigid
 transform of every slot changes no distance, normal or weight (the flyer's bank and the swimmer's yaw
@@ -150,13 +156,19 @@ def run_ticks(data: dict[str, Any]) -> int:
 
 
 def corner_genomes(data: dict[str, Any]) -> list[tuple[str, Genome]]:
-    """The authored genome and every corner of the gait-gene box (colour genes move no slot)."""
-    count = len(data["genes"]["fields"])
+    """The authored genome and every corner of the box of gait genes and size (colour genes move no
+    slot); a gene whose bound is 0 stays at 0."""
+    genes = data["genes"]
+    count = len(genes["fields"]) if genes["jitter"] > 0.0 else 0
+    axes = [(-1.0, 1.0)] * count + [(-1.0, 1.0) if genes["size"] > 0.0 else (0.0,)]
     out = [("authored", Genome(0.0, 0.0, 0.0, (0.0,) * MAX_GAIT_GENES))]
-    if data["genes"]["jitter"] > 0.0:
-        for signs in itertools.product((-1.0, 1.0), repeat=count):
-            label = "genes " + "".join("+" if s > 0 else "-" for s in signs)
-            out.append((label, Genome(0.0, 0.0, 0.0, (*signs, *[0.0] * (MAX_GAIT_GENES - count)))))
+    if count or genes["size"] > 0.0:
+        for *signs, size in itertools.product(*axes):
+            words = ["genes " + "".join("+" if s > 0 else "-" for s in signs)] if signs else []
+            words += [{1.0: "size +", -1.0: "size -"}[size]] if size else []
+            label = " ".join(words)
+            gait = (*signs, *[0.0] * (MAX_GAIT_GENES - len(signs)))
+            out.append((label, Genome(0.0, 0.0, 0.0, gait, size)))
     return out
 
 
@@ -207,7 +219,8 @@ def individual(data: dict[str, Any], support: Support, seed: int, genome: Genome
 def _record(
     data: dict[str, Any], runs: list[tuple[str, Motion]]
 ) -> tuple[list[str], int, F64, F64, list[str]]:
-    """(run labels, ticks per run, quaternions (N, S, 4) wxyz, translations (N, S, 3), sample labels)."""
+    """(run labels, ticks per run, quaternions (N, S, 4) wxyz, translations (N, S, 3) of the unit body,
+    sample labels)."""
     ticks = run_ticks(data)
     labels, quats, trans, sample_labels = [], [], [], []
     for label, motion in runs:
@@ -216,7 +229,7 @@ def _record(
             if tick:
                 motion.step()
             quats.append([[q[3], q[0], q[1], q[2]] for q in motion.quats])
-            trans.append([list(t) for t in motion.trans])
+            trans.append([[c / motion.size for c in t] for t in motion.trans])
             sample_labels.append(f"{label} tick {tick}")
     return labels, ticks, np.asarray(quats), np.asarray(trans), sample_labels
 

@@ -56,6 +56,31 @@ GAIT_GENES: Final[dict[str, tuple[tuple[str, ...], ...]]] = {
     "flyer": (("speed",), ("pathRadius",), ("altitude",)),
     "swimmer": (("speed",), ("undulation",)),
 }
+#: The motion-data fields that are lengths, which an individual's size s scales (creature/genome.py
+#: express_size), and those that are speeds, which it scales by √s: Froude similarity (v²/gL held), so with
+#: gravity unscaled every time (stance, swing, air, flap and undulation periods) scales by √s alike and the
+#: gait keeps its proportions. Shipped as ``lengths`` so the JS core scales the very same fields.
+#: Directions, angles, cosines, ratios, counts and indices are neither.
+SIZED_FIELDS: Final[dict[str, tuple[str, ...]]] = {
+    "speeds": ("speed",),
+    "top": (
+        "bodyScale",
+        "groundY",
+        "centreY",
+        "pathRadius",
+        "stepLength",
+        "stepLengthSpec",
+        "stepLimit",
+        "stepHeight",
+        "hopLength",
+        "hopHeight",
+        "altitude",
+        "pivot",
+    ),
+    "legs": ("hip", "knee", "foot", "a", "b", "reachMin", "reachMax"),
+    "ropes": ("rest", "before", "radius", "segment", "bendMin"),
+    "wings": ("length",),
+}
 
 
 def _v(x: Any) -> list[float]:
@@ -206,5 +231,10 @@ def build_motion(spec: CharacterSpec, rig: CompiledRig, skeleton: Skeleton) -> d
         },
         # Rope nodes of creatures that stand on the support stay above it by their radius.
         "ropeGround": kind in WALKERS or kind == "hopper",
-        "genes": {"jitter": spec.genetics.gait, "fields": [list(g) for g in GAIT_GENES.get(kind, ())]},
+        "genes": {
+            "jitter": spec.genetics.gait,
+            "fields": [list(g) for g in GAIT_GENES.get(kind, ())],
+            "size": spec.genetics.size,
+        },
+        "lengths": {group: list(names) for group, names in SIZED_FIELDS.items()},
     }

@@ -20,7 +20,7 @@ import struct
 from dataclasses import dataclass, field
 from typing import Any
 
-from ..creature.genome import Genome, draw_genome, express_gait
+from ..creature.genome import Genome, draw_genome, express, individual_size
 from ..creature.pose import instance_yaw
 from . import quat as vq
 from .derived import Derived, derive
@@ -91,9 +91,11 @@ class Motion:
         position: tuple[float, float, float] = (0.0, 0.0, 0.0),
         genome: Genome | None = None,
     ) -> None:
-        # The individual's motion data: the authored parameters scaled by its gait genes (the seed's, unless
-        # a genome is given).
-        self.data = express_gait(data, genome if genome is not None else draw_genome(seed))
+        # The individual's motion data: the authored parameters scaled by its size and gait genes (the
+        # seed's, unless a genome is given). Its size also scales its rest geometry (creature/pose.py).
+        genes = genome if genome is not None else draw_genome(seed)
+        self.size = individual_size(data, genes)
+        self.data = express(data, genes)
         self.kind = str(data["type"])
         self.support: Support = support or FlatGround()
         self.gravity = gravity or Gravity()

@@ -117,7 +117,10 @@ class Genetics(StrictModel):
     [-1, 1) times its bound). Colours mutate in OKLab on the authored sRGB colours: one hue rotation, chroma
     scale and lightness shift per individual, so the pattern of the body stays coherent. Gait genes scale
     the locomotion parameters of its type (walkers: pace, i.e. speed with stepLength, and stepHeight).
-    Morphology bounds the build-time identities of ``build --population N``, never a spawn."""
+    Size scales a spawned individual as a whole (a similarity: its shape, blend widths and every length of
+    its motion, never gravity), which keeps it inside the fixed-connectivity envelope the build certified.
+    Morphology (girth, limb and tail proportions) bounds the build-time identities of
+    ``build --population N``, never a spawn."""
 
     hue: Annotated[Number, Field(ge=0, le=180)] = Field(
         default=20.0, description="Largest hue rotation in the OKLab a-b plane, degrees."
@@ -132,6 +135,12 @@ class Genetics(StrictModel):
         default=0.08,
         description="Largest relative change of each gait gene (a walker's step length stays "
         "within its reach limit).",
+    )
+    size: Annotated[Number, Field(ge=0, le=0.25)] = Field(
+        default=0.08,
+        description="Largest relative change of an individual's size at spawn: its whole body and every "
+        "length of its motion scale by 1 + size·gene (a similarity of the certified body, so the same mesh; "
+        "gravity is not scaled).",
     )
     morphology: Annotated[Number, Field(ge=0, le=0.25)] = Field(
         default=0.1,

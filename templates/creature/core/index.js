@@ -2,7 +2,9 @@
 // locomotion core (driver, providers, motion) that poses every body.
 export { CREATURE } from './data.js';
 export { lcgNext, instanceYaw, mixSeed } from './lcg.js';
-export { GENOME_LENGTH, drawGenome, expressGait, genomeColours } from './genome.js';
+export {
+  GENOME_LENGTH, SIZE_DRAW, drawGenome, express, expressGait, expressSize, genomeColours, individualSize,
+} from './genome.js';
 export { rootBounds, rotate, writePoseRows, writeRootRows } from './pose.js';
 export { hashBytes } from './hash.js';
 export { parseGlb } from './glb.js';

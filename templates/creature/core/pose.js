@@ -1,7 +1,7 @@
 // Pose pages: one instance's per-slot transforms (from the locomotion core, core/motion/motion.js) as the
 // float32 rows the GPU reads, the same arithmetic in the same order as creaturegen's Python reference
-// (creature/pose.py pose_rows). A posed point is x' = R(q_s)·x + t_s in creature-local space; the root
-// (position, heading, squash) is applied once, by the material.
+// (creature/pose.py pose_rows). A posed point is x' = R(q_s)·(size·x) + t_s in creature-local space, size
+// the individual's (core/genome.js); the root (position, heading, squash) is applied once, by the material.
 
 import { rotate } from './motion/quat.js';
 
@@ -12,9 +12,10 @@ export { rotate };
  * (a, ra), (b, rb), (k, rgb), quaternion xyzw, (t, roundCone), from per-slot `quats` (xyzw) and `trans`,
  * and the individual's per-slot linear rgb `colours` at offset `co` (core/genome.js genomeColours; null
  * writes the authored colours). `tmp` is a 3-float scratch. Returns the creature-local AABB of the posed
- * primitives into `bounds` (min xyz, max xyz). Allocates nothing.
+ * primitives into `bounds` (min xyz, max xyz). `size` scales the rest ends, radii and blend widths (the
+ * motion's `size`). Allocates nothing.
  */
-export function writePoseRows(data, quats, trans, colours, co, tmp, target, base, bounds) {
+export function writePoseRows(data, quats, trans, colours, co, tmp, target, base, bounds, size = 1) {
   const slots = data.slots;
   const rows = data.poseRows;
   let minX = Infinity, minY = Infinity, minZ = Infinity, maxX = -Infinity, maxY = -Infinity, maxZ = -Infinity;
@@ -23,9 +24,10 @@ export function writePoseRows(data, quats, trans, colours, co, tmp, target, base
     const o = base + s * rows * 4;
     for (let end = 0; end < 2; end++) {
       const c = end * 4;
-      rotate(quats, 4 * s, row, c, tmp, 0);
+      tmp[0] = row[c] * size; tmp[1] = row[c + 1] * size; tmp[2] = row[c + 2] * size;
+      rotate(quats, 4 * s, tmp, 0, tmp, 0);
       const x = tmp[0] + trans[3 * s], y = tmp[1] + trans[3 * s + 1], z = tmp[2] + trans[3 * s + 2];
-      const r = row[c + 3];
+      const r = row[c + 3] * size;
       target[o + c] = x; target[o + c + 1] = y; target[o + c + 2] = z; target[o + c + 3] = r;
       if (x - r < minX) minX = x - r;
       if (y - r < minY) minY = y - r;
@@ -34,7 +36,7 @@ export function writePoseRows(data, quats, trans, colours, co, tmp, target, base
       if (y + r > maxY) maxY = y + r;
       if (z + r > maxZ) maxZ = z + r;
     }
-    target[o + 8] = row[8];
+    target[o + 8] = row[8] * size;
     if (colours) {
       const c = co + 3 * s;
       target[o + 9] = colours[c]; target[o + 10] = colours[c + 1]; target[o + 11] = colours[c + 2];
@@ -50,12 +52,12 @@ export function writePoseRows(data, quats, trans, colours, co, tmp, target, base
 }
 
 /**
- * Write the two root rows at float offset `at`: (x, y, z, alive), (cos yaw, sin yaw, squash, 0), from a
- * root (x, y, z, cos, sin, squash) as the locomotion core keeps it.
+ * Write the two root rows at float offset `at`: (x, y, z, alive), (cos yaw, sin yaw, squash, size), from a
+ * root (x, y, z, cos, sin, squash) as the locomotion core keeps it and the individual's size.
  */
-export function writeRootRows(root, alive, target, at) {
+export function writeRootRows(root, alive, target, at, size = 1) {
   target[at] = root[0]; target[at + 1] = root[1]; target[at + 2] = root[2]; target[at + 3] = alive;
-  target[at + 4] = root[3]; target[at + 5] = root[4]; target[at + 6] = root[5]; target[at + 7] = 0;
+  target[at + 4] = root[3]; target[at + 5] = root[4]; target[at + 6] = root[5]; target[at + 7] = size;
 }
 
 /**

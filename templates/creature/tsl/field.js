@@ -31,7 +31,7 @@ function perpendicular(axis) {
  * (a, ra), (b, rb), (k, rgb), quaternion, (t, roundCone). `programs` is a vec4 storage node: program
  * headers (offset, count, 0, 0) first, then instructions. `registers` bounds the register file (K).
  */
-export function createField({ pose, programs, rows, registers, gradientFloor, tiny }) {
+export function createField({ pose, programs, rows, slotCount, registers, gradientFloor, tiny }) {
   // primitives._Frame and both distance forms, with their gradients. Returns vec4(d, ∇d).
   const slotField = (p, base, slot) => {
     const o = base.add(slot.mul(rows));
@@ -104,6 +104,8 @@ export function createField({ pose, programs, rows, registers, gradientFloor, ti
    * over the program's leaves, read from the leaf registers this run already filled (linear RGB).
    */
   const evaluate = (p, base, program, { colour = false, kFloor = 0 } = {}) => {
+    // The instance's size (root row 1 .w): blend widths scale with the body (the slot rows already do).
+    const size = pose.element(base.add(slotCount * rows + 1)).w.toVar();
     const header = programs.element(program);
     const offset = int(header.x).toVar();
     const count = int(header.y).toVar();
@@ -111,7 +113,7 @@ export function createField({ pose, programs, rows, registers, gradientFloor, ti
     Loop(count, ({ i }) => {
       const ins = programs.element(offset.add(i)).toVar();
       const op = int(ins.x).toVar();
-      const ia = int(ins.y), ib = int(ins.z), k = ins.w;
+      const ia = int(ins.y), ib = int(ins.z), k = ins.w.mul(size);
       If(op.equal(OP.LEAF), () => {
         regs.element(i).assign(slotField(p, base, ia));
       }).ElseIf(op.equal(OP.POLY), () => {
@@ -148,7 +150,7 @@ export function createField({ pose, programs, rows, registers, gradientFloor, ti
       const ins = programs.element(offset.add(i));
       If(int(ins.x).equal(OP.LEAF), () => {
         const row = pose.element(base.add(int(ins.y).mul(rows)).add(2));
-        const w = exp(max(regs.element(i).x.sub(dMin), 0).negate().div(max(row.x, kFloor)));
+        const w = exp(max(regs.element(i).x.sub(dMin), 0).negate().div(max(row.x, size.mul(kFloor))));
         sum.addAssign(w);
         rgb.addAssign(row.yzw.mul(w));
       });

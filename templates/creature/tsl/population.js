@@ -177,8 +177,9 @@ export async function createCreaturePopulation(renderer, options = {}) {
   // and its world bounds; marks the instance dirty for the next flush.
   function writeInstance(page, j, quats, trans, root) {
     const base = j * floatsPerInstance;
-    writePoseRows(data, quats, trans, page.colours, 3 * data.slotCount * j, tmp, page.staging, base, localBox);
-    writeRootRows(root, page.alive[j], page.staging, base + rootRow);
+    const size = page.motions[j].size;
+    writePoseRows(data, quats, trans, page.colours, 3 * data.slotCount * j, tmp, page.staging, base, localBox, size);
+    writeRootRows(root, page.alive[j], page.staging, base + rootRow, size);
     rootBounds(localBox, root, page.bounds, 6 * j);
     page.dirtyLo = Math.min(page.dirtyLo, j);
     page.dirtyHi = Math.max(page.dirtyHi, j);

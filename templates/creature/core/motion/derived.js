@@ -20,7 +20,8 @@ export function derive(data, gravity) {
     const legLen = sum / data.legs.length;
     swing = Math.max(2, ticksFromSeconds(c.swingFroude * Math.sqrt(legLen / g), hz));
     let stance = 0;
-    if (speed > 0) stance = Math.floor((1 + c.stepLead) * data.stepLength / (speed * dt)) + 1;
+    // One whole tick to spare past the rounding (creaturegen motion/derived.py says why).
+    if (speed > 0) stance = Math.floor((1 + c.stepLead) * data.stepLength / (speed * dt)) + 2;
     window = Math.max(swing + 1, Math.ceil((swing + stance) / data.groups));
     cycle = data.groups * window;
   }

@@ -2,8 +2,13 @@
 // Genomes: what makes one spawned individual differ from another, drawn from its seed by the LCG, the same
 // scalar arithmetic in the same order as creaturegen's Python reference (creature/genome.py), so the two
 // agree bit for bit. Genes are signed draws in [-1, 1) of the stream from mixSeed(seed): draw 1 is
-// reserved, draw 2 is the heading (instanceYaw), draws 3, 4, 5 are hue, chroma and lightness, draws 6..
-// the gait genes.
+// reserved, draw 2 is the heading (instanceYaw), draws 3, 4, 5 are hue, chroma and lightness, draws 6, 7, 8
+// the gait genes, draw 9 the size.
+//
+// Size is a similarity of the certified body (the only morphology a spawn carries): its rest geometry
+// (pose.js writePoseRows, tsl/body.js) and every motion length (expressSize) scale by 1 + size·gene, so
+// the same mesh stays valid; gravity is not scaled, so speeds scale by its square root (Froude
+// similarity). Proportions are build-time identities.
 //
 // Colour genes act in OKLab on the authored sRGB colours (their OKLab coordinates are computed at build
 // time, CREATURE.slotLab): one hue rotation, chroma scale and lightness shift per individual, converted
@@ -17,13 +22,14 @@ export const CHROMA_DRAW = 4;
 export const LIGHTNESS_DRAW = 5;
 export const GAIT_DRAW = 6;
 export const MAX_GAIT_GENES = 3;
-/** Floats in a genome array: hue, chroma, lightness, then MAX_GAIT_GENES gait genes. */
-export const GENOME_LENGTH = 3 + MAX_GAIT_GENES;
+export const SIZE_DRAW = GAIT_DRAW + MAX_GAIT_GENES;
+/** Floats in a genome array: hue, chroma, lightness, MAX_GAIT_GENES gait genes, then size. */
+export const GENOME_LENGTH = 4 + MAX_GAIT_GENES;
 
 /** Write the genome of the individual spawned from `seed` into `out` (GENOME_LENGTH floats). */
 export function drawGenome(seed, lcg, out = new Float64Array(GENOME_LENGTH)) {
   let state = mixSeed(seed);
-  for (let draw = 1; draw < GAIT_DRAW + MAX_GAIT_GENES; draw++) {
+  for (let draw = 1; draw <= SIZE_DRAW; draw++) {
     state = lcgNext(state, lcg.a, lcg.c);
     if (draw >= HUE_DRAW) out[draw - HUE_DRAW] = state / 2147483648 - 1;
   }
@@ -74,4 +80,49 @@ export function expressGait(motion, genome) {
     for (const name of group) expressed[name] = motion[name] * factor;
   });
   return expressed;
+}
+
+/** The size factor of an individual: 1 + motion.genes.size·gene (creaturegen's individual_size). */
+export function individualSize(motion, genome) {
+  return 1 + motion.genes.size * genome[SIZE_DRAW - HUE_DRAW];
+}
+
+const scaled = (value, factor) => (Array.isArray(value) ? value.map((v) => scaled(v, factor)) : value * factor);
+
+/**
+ * The motion data of an individual of `size`: every length `motion.lengths` names (top-level, and per leg,
+ * rope and wing) times `size`, nested arrays element by element, and every speed times √size (Froude
+ * similarity: gravity is not scaled, so every time scales by √size). Returns a new object; `motion` is not
+ * modified.
+ */
+export function expressSize(motion, size) {
+  const names = motion.lengths;
+  const expressed = { ...motion };
+  for (const name of names.speeds) expressed[name] = motion[name] * Math.sqrt(size);
+  for (const name of names.top) expressed[name] = scaled(motion[name], size);
+  for (const group of ['legs', 'ropes', 'wings']) {
+    expressed[group] = motion[group].map((item) => {
+      const out = { ...item };
+      for (const name of names[group]) out[name] = scaled(item[name], size);
+      return out;
+    });
+  }
+  return expressed;
+}
+
+// Numbers JSON cannot carry exactly travel as tagged strings, so the copy below is bit for bit.
+const TAG = '\u0000';
+const tagged = (k, v) => (typeof v === 'number' && (Object.is(v, -0) || !Number.isFinite(v)) ? `${TAG}${Object.is(v, -0) ? '-0' : v}` : v);
+const untagged = (k, v) => (typeof v === 'string' && v[0] === TAG ? Number(v.slice(1)) : v);
+
+/**
+ * The motion data of an individual: its size first, then its gait genes (creaturegen's express), as one
+ * fresh copy built by JSON.parse. Copies made by spread-and-assign and Array.map left some legs' fields and
+ * arrays in layouts whose loads box doubles in the hot step (288 B per quadruped step, measured by
+ * bench/motion.mjs); JSON.parse builds V8's fast packed layouts, and the step allocates nothing again.
+ * Spawn-time only.
+ */
+export function express(motion, genome) {
+  const individual = expressGait(expressSize(motion, individualSize(motion, genome)), genome);
+  return JSON.parse(JSON.stringify(individual, tagged), untagged);
 }

@@ -11,16 +11,26 @@ export function mixSeed(seed: number): number;
 export function instanceYaw(seed: number, lcg: { a: number; c: number }): number;
 /** R(q)·v with q at q[qo..qo+3] (xyzw) and v at v[vo..vo+2]; vectors travel as (array, offset) so no call boxes a double. */
 export function rotate(q: ArrayLike<number>, qo: number, v: ArrayLike<number>, vo: number, out: Vec, o: number): void;
-export function writePoseRows(data: unknown, quats: ArrayLike<number>, trans: ArrayLike<number>, colours: ArrayLike<number> | null, co: number, tmp: Float64Array, target: Float32Array, base: number, bounds: Float64Array): void;
-/** Floats in a genome: hue, chroma, lightness, then the gait genes (signed, in [-1, 1)). */
+/** An instance's slot rows; `size` (the motion's) scales the rest ends, radii and blend widths. */
+export function writePoseRows(data: unknown, quats: ArrayLike<number>, trans: ArrayLike<number>, colours: ArrayLike<number> | null, co: number, tmp: Float64Array, target: Float32Array, base: number, bounds: Float64Array, size?: number): void;
+/** Floats in a genome: hue, chroma, lightness, the gait genes, then size (each signed, in [-1, 1)). */
 export const GENOME_LENGTH: number;
+/** LCG draw (1-based) of the size gene. */
+export const SIZE_DRAW: number;
 /** The genome of the individual spawned from `seed` (LCG draws 3 onwards). */
 export function drawGenome(seed: number, lcg: { a: number; c: number }, out?: Float64Array): Float64Array;
 /** Per-slot linear rgb of an individual (its colour genes applied in OKLab to the authored colours). */
 export function genomeColours(data: unknown, genome: ArrayLike<number>, out: Float64Array, o?: number): Float64Array;
 /** The motion data of an individual: gene-listed gait parameters scaled by 1 + jitter·gene. */
 export function expressGait<T extends object>(motion: T, genome: ArrayLike<number>): T;
-export function writeRootRows(root: ArrayLike<number>, alive: number, target: Float32Array, at: number): void;
+/** An individual's size factor, 1 + genes.size·gene: a similarity of the whole body (gravity unscaled). */
+export function individualSize(motion: unknown, genome: ArrayLike<number>): number;
+/** The motion data with every field `motion.lengths` names scaled by `size`. */
+export function expressSize<T extends object>(motion: T, size: number): T;
+/** The motion data of an individual: expressSize, then expressGait. */
+export function express<T extends object>(motion: T, genome: ArrayLike<number>): T;
+/** The root rows (x, y, z, alive), (cos yaw, sin yaw, squash, size). */
+export function writeRootRows(root: ArrayLike<number>, alive: number, target: Float32Array, at: number, size?: number): void;
 export function rootBounds(local: ArrayLike<number>, root: ArrayLike<number>, out: Float64Array, at: number): void;
 export function hashBytes(bytes: Uint8Array | Uint8Array[], tick: number): string;
 export function parseGlb(buffer: ArrayBuffer): { attributes: Record<string, { array: Float32Array | Uint16Array | Uint32Array; itemSize: number }>; index: { array: Uint16Array | Uint32Array }; extras: Record<string, unknown> };
@@ -77,6 +87,8 @@ export interface MotionGates {
 export interface Motion {
   readonly kind: string;
   readonly tick: number;
+  /** The individual's size factor (its body and every motion length are scaled by it). */
+  readonly size: number;
   /** Per-slot quaternions (xyzw) and translations, creature-local. */
   readonly quats: Float64Array;
   readonly trans: Float64Array;

@@ -11,7 +11,7 @@
 // Integer ticks are authoritative: seekTick(n) resets and steps n times, so it equals n step() calls bit
 // for bit. Nothing allocates after createMotion (typed scratch only); the only variation is the seeded LCG.
 
-import { drawGenome, expressGait } from '../genome.js';
+import { drawGenome, express, individualSize } from '../genome.js';
 import { instanceYaw } from '../lcg.js';
 import { hashBytes } from '../hash.js';
 import { axisAngle, fromFrames, fromTo, gramSchmidt, mul, normalizeInto, rotate } from './quat.js';
@@ -36,9 +36,11 @@ export function assertWaterFor(kind, water, who = kind) {
 }
 
 export function createMotion(data, lcg, { support = createFlatGround(), gravity = createGravity(), water = null, seed = 0, position = [0, 0, 0], genome = null } = {}) {
-  // The individual's motion data: the authored parameters scaled by its gait genes (the seed's, unless a
-  // genome is given).
-  const m = expressGait(data, genome ?? drawGenome(seed, lcg));
+  // The individual's motion data: the authored parameters scaled by its size and gait genes (the seed's,
+  // unless a genome is given). Its size also scales its rest geometry (core/pose.js writePoseRows).
+  const genes = genome ?? drawGenome(seed, lcg);
+  const size = individualSize(data, genes);
+  const m = express(data, genes);
   const kind = m.type;
   assertWaterFor(kind, water);
   const gravity0 = gravity.at(0, new Float64Array(3));
@@ -649,7 +651,7 @@ export function createMotion(data, lcg, { support = createFlatGround(), gravity 
   }
 
   const motion = {
-    data: m, derived: d, kind, quats, trans, root, prevQuats, prevTrans, prevRoot, nodes, support, gravity, water,
+    data: m, derived: d, kind, size, quats, trans, root, prevQuats, prevTrans, prevRoot, nodes, support, gravity, water,
     get gates() { return readGates(); },
     get tick() { return tick; },
     reset,
