@@ -64,9 +64,11 @@ def test_every_example_passes_every_parity_gate(name: str, out_root: Path) -> No
         assert "genome colours of 64 individuals: GPU pose rows vs Python (OKLab mutation)" in names
         grid = written["measurements"]["grid"]
         print(f"{name} grid: {grid}")
-        low, high = grid["pace"]
+        low, high = grid["speedRatio"]
         # Paces above 1 are capped where the step length sits at its reach limit (the lizard's does).
-        assert high - low > 0.05, f"{name}: the grid's paces {grid['pace']} hardly vary"
+        assert high - low > 0.05, f"{name}: the grid's speeds {grid['speedRatio']} hardly vary"
+        small, large = grid["size"]
+        assert large - small > 0.05, f"{name}: the grid's sizes {grid['size']} hardly vary"
         assert (package / "parity" / "grid.png").stat().st_size > 1000
 
 

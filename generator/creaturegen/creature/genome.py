@@ -15,8 +15,9 @@ starts at ``mix_seed(seed)`` (draw 1 is reserved, draw 2 is the heading, see pos
   rotation) and every length of the motion data scale together, so the field of an individual of size s is
   ``s·f(x/s)`` and its skinned, corrected mesh is the certified one scaled by s, with the same connectivity,
   the same signed Jacobians (times s³) and the same surface error relative to its own length. Gravity is
-  not scaled, so speeds scale by √s (Froude similarity: every time scales by √s and the gait keeps its
-  proportions up to whole ticks), and the build's pose envelope steps the size corners too. Proportions
+  not scaled, so speeds scale by √s (Froude similarity: every time derived from lengths, speeds and gravity
+  scales by √s and the gait keeps its proportions up to whole ticks; the hopper's stated crouch and landing
+  seconds stay), and the build's pose envelope steps the size corners too. Proportions
   (girth, limbs, tails) change the shape, so they are build-time identities (creature/morphology.py),
   never a spawn.
 

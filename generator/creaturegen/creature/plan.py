@@ -85,7 +85,7 @@ def build_plan(
         "tier": surface.tier,
         "bodyScale": rig.body_scale,
         "slotCount": rig.slot_count,
-        # One extra "part" per instance: the root rows (position + alive, yaw cos/sin + squash).
+        # One extra "part" per instance: the root rows (position + alive, yaw cos/sin + squash + size).
         "maxParts": rig.slot_count + 1,
         "poseRows": POSE_ROWS,
         "slots": rig.slots.tolist(),

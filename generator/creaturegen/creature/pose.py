@@ -114,7 +114,7 @@ def pose_rows(
     rows[:, 2, 1:4] = slots[:, col.RGB] if colours is None else np.asarray(colours, dtype=np.float64)
     rows[:, 3] = np.asarray(quats, dtype=np.float64)
     rows[:, 4, :3] = t
-    rows[:, 4, 3] = slot_uses_round_cone(slots)
+    rows[:, 4, 3] = slot_uses_round_cone(rig.slots)  # the certified body's choice, as CREATURE.roundCone
     return rows.astype(np.float32)
 
 

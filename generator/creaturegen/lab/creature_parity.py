@@ -340,14 +340,15 @@ def _pictures(page: Page, package: Path, debug: bool) -> None:
 def _grid_gates(page: Page, ref: cref.PackageReference, package: Path, report: ParityReport) -> None:
     """The genetics grid: each individual's GPU pose rows against the Python reference spawned from the same
     seed and position (the colour rows alone at float32 rounding, all rows relative to L), and how far the
-    individuals differ: colour (OKLab distance of the mean slot colour to the authored one), pace and size."""
+    individuals differ: colour (OKLab distance of the mean slot colour to the authored one), speed (pace gene
+    and √size together) and size."""
     # Not drawn at spawn: the step's one upload and deform pre-pass draws all 64.
     bodies = page.evaluate(f"() => window.__lab.grid({GRID_SIDE}, {GRID_SEED}, {GRID_SPACING}, false)")
     page.evaluate(f"() => window.__lab.stepTicks({GRID_TICK})")
     scale = ref.rig.body_scale
     slots = ref.rig.slot_count
     worst_rows = worst_colour = 0.0
-    colours, paces, sizes = [], [], []
+    colours, speeds, sizes = [], [], []
     for body in bodies:
         gpu = np.asarray(page.evaluate(f"() => window.__lab.readPose({body['id']})"), dtype=np.float32)
         seed = int(body["seed"])
@@ -365,7 +366,7 @@ def _grid_gates(page: Page, ref: cref.PackageReference, package: Path, report: P
         colour_rows = got[: slots * POSE_ROWS * 4].reshape(slots, POSE_ROWS, 4)[:, 2, 1:4]
         worst_colour = max(worst_colour, float(np.abs(colour_rows - np.asarray(mine, np.float32)).max()))
         colours.append(colour_rows.astype(np.float64).ravel())
-        paces.append(motion.data["speed"] / ref.motion["speed"] if ref.motion["speed"] > 0 else 1.0)
+        speeds.append(motion.data["speed"] / ref.motion["speed"] if ref.motion["speed"] > 0 else 1.0)
         sizes.append(motion.size)
     report.gate(
         f"genome colours of {len(bodies)} individuals: GPU pose rows vs Python (OKLab mutation)",
@@ -393,7 +394,7 @@ def _grid_gates(page: Page, ref: cref.PackageReference, package: Path, report: P
         "tick": GRID_TICK,
         "minColourGapLinear": float(gaps.min()),
         "oklabShift": {"median": float(np.median(shift)), "max": float(shift.max())},
-        "pace": [float(min(paces)), float(max(paces))],
+        "speedRatio": [float(min(speeds)), float(max(speeds))],
         "size": [float(min(sizes)), float(max(sizes))],
     }
     shot = page.evaluate("() => window.__lab.capturePixels('grid')")

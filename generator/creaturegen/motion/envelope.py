@@ -46,7 +46,7 @@ from typing import Any, Final
 import numpy as np
 import numpy.typing as npt
 
-from ..creature.genome import MAX_GAIT_GENES, Genome
+from ..creature.genome import MAX_GAIT_GENES, Genome, express
 from ..creature.pose import instance_yaw
 from ..field import layout as col
 from ..rig import CompiledRig
@@ -139,20 +139,26 @@ class PoseEnvelope:
         }
 
 
-def run_ticks(data: dict[str, Any]) -> int:
-    """Ticks per run: CYCLES of the creature's own period, and at least MIN_SECONDS."""
+def _period(data: dict[str, Any]) -> int:
+    """Ticks of one cycle of an individual's motion (0 where it has none)."""
     d = derive(data, Gravity().at(0.0))
     kind = data["type"]
-    period = 0
     if kind in WALKERS:
-        period = d.cycle
-    elif kind == "hopper":
-        period = d.hop_cycle
-    elif kind == "flyer" and d.flap_hz > 0.0:
-        period = math.ceil(d.hz / d.flap_hz)
-    elif kind == "swimmer" and d.undulation_hz > 0.0:
-        period = math.ceil(d.hz / d.undulation_hz)
-    return max(CYCLES * period, math.ceil(MIN_SECONDS * d.hz))
+        return d.cycle
+    if kind == "hopper":
+        return d.hop_cycle
+    if kind == "flyer" and d.flap_hz > 0.0:
+        return math.ceil(d.hz / d.flap_hz)
+    if kind == "swimmer" and d.undulation_hz > 0.0:
+        return math.ceil(d.hz / d.undulation_hz)
+    return 0
+
+
+def run_ticks(data: dict[str, Any]) -> int:
+    """Ticks per run: CYCLES of the slowest corner individual's period (gait and size genes stretch it),
+    and at least MIN_SECONDS."""
+    period = max(_period(express(data, genome)) for _, genome in corner_genomes(data))
+    return max(CYCLES * period, math.ceil(MIN_SECONDS * int(data["hz"])))
 
 
 def corner_genomes(data: dict[str, Any]) -> list[tuple[str, Genome]]:

@@ -58,8 +58,10 @@ GAIT_GENES: Final[dict[str, tuple[tuple[str, ...], ...]]] = {
 }
 #: The motion-data fields that are lengths, which an individual's size s scales (creature/genome.py
 #: express_size), and those that are speeds, which it scales by √s: Froude similarity (v²/gL held), so with
-#: gravity unscaled every time (stance, swing, air, flap and undulation periods) scales by √s alike and the
-#: gait keeps its proportions. Shipped as ``lengths`` so the JS core scales the very same fields.
+#: gravity unscaled every time derived from lengths, speeds and gravity (stance, swing, air, hop cycle, flap
+#: and undulation periods) scales by √s alike and the gait keeps its proportions. The hopper's stated crouch
+#: and landing times (HOP_CROUCH_S, HOP_LAND_S) are seconds and stay. Shipped as ``lengths`` so the JS core
+#: scales the very same fields.
 #: Directions, angles, cosines, ratios, counts and indices are neither.
 SIZED_FIELDS: Final[dict[str, tuple[str, ...]]] = {
     "speeds": ("speed",),

@@ -2,7 +2,7 @@
 // the diagnostic shell, diagnostics.
 export { OP, createField } from './field.js';
 export { METHOD, createSkin, rotate } from './skin.js';
-export { bodyFunctions, bodyVertex, layoutOf } from './body.js';
+export { bodyFunctions, bodyVertex, layoutOf, rootSize } from './body.js';
 export {
   DEFORM_STRIDE, RECORD_STRIDE, createDeformKernel, deformStorage, deformView, dispatchDeform, recordInputs, vertexRecords,
 } from './deform.js';

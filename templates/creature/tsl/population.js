@@ -277,7 +277,8 @@ export async function createCreaturePopulation(renderer, options = {}) {
     /**
      * Validate and add one body at `position` (its path starts there; the locomotion core puts it on the
      * support, on the water or at the flyer's altitude). Its seed is its genome (core/genome.js): heading,
-     * colour genes (hue, chroma, lightness in OKLab) and gait genes, within the package's genetics bounds.
+     * colour genes (hue, chroma, lightness in OKLab), gait genes and its size, within the package's genetics
+     * bounds.
      * Builds its CPU motion state and writes O(slots) rows: no geometry, material, buffer or pipeline is
      * created. Its motion starts at its own tick 0.
      */

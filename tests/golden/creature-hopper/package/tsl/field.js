@@ -33,6 +33,7 @@ function perpendicular(axis) {
  * headers (offset, count, 0, 0) first, then instructions. `registers` bounds the register file (K).
  */
 export function createField({ pose, programs, rows, slotCount, registers, gradientFloor, tiny }) {
+  if (!Number.isInteger(slotCount) || slotCount < 1) throw new Error(`createField: slotCount must be a positive integer (got ${slotCount})`);
   // primitives._Frame and both distance forms, with their gradients. Returns vec4(d, ∇d).
   const slotField = (p, base, slot) => {
     const o = base.add(slot.mul(rows));
