@@ -223,3 +223,23 @@ def test_morphology_leaves_explicit_nulls_alone() -> None:
     document["parts"][0]["k"] = None
     variant = variant_document(document, 1, 0.1)
     assert variant["parts"][0]["k"] is None
+
+
+def _numbers(value: object) -> list[float]:
+    if isinstance(value, dict):
+        return [x for v in value.values() for x in _numbers(v)]
+    if isinstance(value, list):
+        return [x for v in value for x in _numbers(v)]
+    return [value] if isinstance(value, float) else []
+
+
+@pytest.mark.parametrize("name", ["reference/quadruped.json", "reference/flyer.json", "lizard.json"])
+def test_motion_data_survives_a_json_round_trip_exactly(name: str) -> None:
+    """core/genome.js express copies an individual's motion data through JSON (V8's fast layouts, so the
+    step allocates nothing): exact only if no number is -0 or non-finite, which build_motion ensures."""
+    data = _motion(name)
+    numbers = _numbers(data)
+    assert numbers
+    assert all(math.isfinite(x) for x in numbers), f"{name}: a non-finite number in the motion data"
+    assert not any(x == 0.0 and math.copysign(1.0, x) < 0 for x in numbers), f"{name}: -0 in the motion data"
+    assert json.loads(json.dumps(data)) == data

@@ -94,7 +94,9 @@ def fields_of(loco: Any) -> dict[str, Any]:
 
 
 def build_motion(spec: CharacterSpec, rig: CompiledRig, skeleton: Skeleton) -> dict[str, Any]:
-    """``CREATURE.motion``: plain JSON numbers, read by the Python reference and the JS core alike."""
+    """``CREATURE.motion``: plain JSON numbers, read by the Python reference and the JS core alike. Every
+    number is finite and none is -0 (:func:`_plain`), so a JSON round trip of the data, or of an individual's
+    copy (core/genome.js express), is exact."""
     loco = spec.locomotion
     kind = loco.type if loco is not None else "none"
     slots = rig.slots
@@ -192,51 +194,71 @@ def build_motion(spec: CharacterSpec, rig: CompiledRig, skeleton: Skeleton) -> d
     centre_y = sum(0.5 * (float(slots[r, 1]) + float(slots[r, 5])) for r in roots) / len(roots)
     fields = fields_of(loco)
     speed = float(fields.get("speed", 0.0))
-    return {
-        "type": kind,
-        "hz": int(fields.get("tickRate", 60)),
-        "speed": speed,
-        "bodyScale": body,
-        "groundY": ground,
-        "centreY": centre_y,
-        "pathRadius": float(fields["radius"]) * spec.scale if kind == "flyer" else PATH_RADIUS_BODIES * body,
-        "stepLength": min(step_spec, step_limit) if legs else step_spec,
-        "stepLengthSpec": step_spec,
-        "stepLimit": step_limit,
-        "stepHeight": float(fields.get("stepHeight", 0.0)) * spec.scale,
-        "hopLength": float(fields.get("hopLength", 0.0)) * spec.scale,
-        "hopHeight": float(fields.get("hopHeight", 0.0)) * spec.scale,
-        "altitude": float(fields.get("altitude", 0.0)) * spec.scale,
-        "undulation": float(fields.get("undulation", 0.0)),
-        "buoyancy": float(fields.get("buoyancy", 1.0)),
-        "groups": len(phases),
-        "legs": legs,
-        "ropes": ropes,
-        "wings": wings,
-        "roots": roots,
-        "parent": list(skeleton.parent),
-        "order": list(skeleton.order),
-        "pivot": [_v(p) for p in skeleton.pivot],
-        "constants": {
-            "swingFroude": SWING_FROUDE,
-            "stepLead": STEP_LEAD,
-            "hopCrouchS": HOP_CROUCH_S,
-            "hopLandS": HOP_LAND_S,
-            "hopSquash": HOP_SQUASH,
-            "hopStretch": HOP_STRETCH,
-            "strouhal": STROUHAL,
-            "swimResponse": SWIM_RESPONSE,
-            "ropeSubsteps": ROPE_SUBSTEPS,
-            "ropePasses": ROPE_PASSES,
-            "ropeDamping": ROPE_DAMPING,
-            "ropeBendLimitDeg": ROPE_BEND_LIMIT_DEG,
-        },
-        # Rope nodes of creatures that stand on the support stay above it by their radius.
-        "ropeGround": kind in WALKERS or kind == "hopper",
-        "genes": {
-            "jitter": spec.genetics.gait,
-            "fields": [list(g) for g in GAIT_GENES.get(kind, ())],
-            "size": spec.genetics.size,
-        },
-        "lengths": {group: list(names) for group, names in SIZED_FIELDS.items()},
-    }
+    return dict(
+        _plain(
+            {
+                "type": kind,
+                "hz": int(fields.get("tickRate", 60)),
+                "speed": speed,
+                "bodyScale": body,
+                "groundY": ground,
+                "centreY": centre_y,
+                "pathRadius": float(fields["radius"]) * spec.scale
+                if kind == "flyer"
+                else PATH_RADIUS_BODIES * body,
+                "stepLength": min(step_spec, step_limit) if legs else step_spec,
+                "stepLengthSpec": step_spec,
+                "stepLimit": step_limit,
+                "stepHeight": float(fields.get("stepHeight", 0.0)) * spec.scale,
+                "hopLength": float(fields.get("hopLength", 0.0)) * spec.scale,
+                "hopHeight": float(fields.get("hopHeight", 0.0)) * spec.scale,
+                "altitude": float(fields.get("altitude", 0.0)) * spec.scale,
+                "undulation": float(fields.get("undulation", 0.0)),
+                "buoyancy": float(fields.get("buoyancy", 1.0)),
+                "groups": len(phases),
+                "legs": legs,
+                "ropes": ropes,
+                "wings": wings,
+                "roots": roots,
+                "parent": list(skeleton.parent),
+                "order": list(skeleton.order),
+                "pivot": [_v(p) for p in skeleton.pivot],
+                "constants": {
+                    "swingFroude": SWING_FROUDE,
+                    "stepLead": STEP_LEAD,
+                    "hopCrouchS": HOP_CROUCH_S,
+                    "hopLandS": HOP_LAND_S,
+                    "hopSquash": HOP_SQUASH,
+                    "hopStretch": HOP_STRETCH,
+                    "strouhal": STROUHAL,
+                    "swimResponse": SWIM_RESPONSE,
+                    "ropeSubsteps": ROPE_SUBSTEPS,
+                    "ropePasses": ROPE_PASSES,
+                    "ropeDamping": ROPE_DAMPING,
+                    "ropeBendLimitDeg": ROPE_BEND_LIMIT_DEG,
+                },
+                # Rope nodes of creatures that stand on the support stay above it by their radius.
+                "ropeGround": kind in WALKERS or kind == "hopper",
+                "genes": {
+                    "jitter": spec.genetics.gait,
+                    "fields": [list(g) for g in GAIT_GENES.get(kind, ())],
+                    "size": spec.genetics.size,
+                },
+                "lengths": {group: list(names) for group, names in SIZED_FIELDS.items()},
+            }
+        )
+    )
+
+
+def _plain(value: Any, place: str = "motion") -> Any:
+    """``value`` with every -0.0 made 0.0 (JSON writes -0 as 0; the two can differ downstream, e.g. in
+    atan2); a non-finite number is a build bug, named by its place."""
+    if isinstance(value, dict):
+        return {k: _plain(v, f"{place}.{k}") for k, v in value.items()}
+    if isinstance(value, list):
+        return [_plain(v, f"{place}[{i}]") for i, v in enumerate(value)]
+    if isinstance(value, float):
+        if not math.isfinite(value):
+            raise ValueError(f"{place}: {value} is not a finite number")
+        return value + 0.0
+    return value

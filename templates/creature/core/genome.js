@@ -109,19 +109,14 @@ export function expressSize(motion, size) {
   return expressed;
 }
 
-// Numbers JSON cannot carry exactly travel as tagged strings, so the copy below is bit for bit.
-const TAG = '\u0000';
-const tagged = (k, v) => (typeof v === 'number' && (Object.is(v, -0) || !Number.isFinite(v)) ? `${TAG}${Object.is(v, -0) ? '-0' : v}` : v);
-const untagged = (k, v) => (typeof v === 'string' && v[0] === TAG ? Number(v.slice(1)) : v);
-
 /**
  * The motion data of an individual: its size first, then its gait genes (creaturegen's express), as one
  * fresh copy built by JSON.parse. Copies made by spread-and-assign and Array.map left some legs' fields and
  * arrays in layouts whose loads box doubles in the hot step (288 B per quadruped step, measured by
  * bench/motion.mjs); JSON.parse builds V8's fast packed layouts, and the step allocates nothing again.
- * Spawn-time only.
+ * The round trip is exact: CREATURE.motion holds only finite numbers and no -0 (creaturegen motion/rig.py),
+ * and the size and gait factors are positive. Spawn-time only.
  */
 export function express(motion, genome) {
-  const individual = expressGait(expressSize(motion, individualSize(motion, genome)), genome);
-  return JSON.parse(JSON.stringify(individual, tagged), untagged);
+  return JSON.parse(JSON.stringify(expressGait(expressSize(motion, individualSize(motion, genome)), genome)));
 }
