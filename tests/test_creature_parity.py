@@ -135,8 +135,8 @@ def test_the_job_catches_a_deform_pre_pass_that_skips_the_correction(out_root: P
         "deform.js",
         [
             (
-                "...recordInputs(records, v), base, size, skinOnly, colour: true",
-                "...recordInputs(records, v), base, size, skinOnly: true, colour: true",
+                "...recordInputs(records, v), base, skinOnly, colour: true",
+                "...recordInputs(records, v), base, skinOnly: true, colour: true",
             )
         ],
     )

@@ -18,11 +18,11 @@ import pytest
 from conftest import build_example
 from creaturegen.creature import reference as cref
 from creaturegen.creature.genome import draw_genome, individual_size
-from creaturegen.creature.pose import as_pose, pose_rows, sized_slots
+from creaturegen.creature.pose import as_pose, pose_rows
 from creaturegen.lab.creature_parity import LAB_SEED, PARITY_TICK
 from creaturegen.motion.providers import AnalyticWater
 from creaturegen.motion.simulate import Motion
-from creaturegen.surface.deform import Pose, posed_slots
+from creaturegen.surface.deform import Pose
 
 #: float64 agreement of the scaled body with the unit body scaled, relative to the body's length.
 SIMILAR = 1e-12
@@ -51,14 +51,14 @@ def test_an_individual_of_any_size_is_the_certified_body_scaled(package: Path) -
     unit.step_ticks(PARITY_TICK)
     assert unit.size == 1.0
     unit_pose = as_pose(unit.quats, unit.trans)
-    unit_table = posed_slots(ref.rig.slots, unit_pose)
+    unit_table = cref.posed_table(ref, unit_pose)
     unit_skin = cref.skinned_reference(ref, unit_pose)
     unit_field = cref.field_at(ref, unit_table, unit_skin)
     faces = np.asarray(ref.asset.indices, dtype=np.int64).reshape(-1, 3)
     unit_normals = _triangle_normals(unit_skin, faces)
     for size in (1.0 - genes, 1.0 + genes):
         pose = Pose(unit_pose.rotations, unit_pose.translations * size)
-        table = posed_slots(sized_slots(ref.rig.slots, size), pose)
+        table = cref.posed_table(ref, pose, size)
         skin = cref.skinned_reference(ref, pose, size)
         where = f"{package.name} size {size}"
         assert np.abs(skin - size * unit_skin).max() <= SIMILAR * scale, f"{where}: skinning is not similar"

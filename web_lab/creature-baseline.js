@@ -72,7 +72,7 @@ export function createBaselineField(tsl, layout, pose, programs, step) {
     const offset = int(header.x).toVar();
     const count = int(header.y).toVar();
     const regs = array('float', layout.registers).toVar();
-    const size = pose.element(base.add(P * rows + 1)).w.toVar(); // the instance's size scales blend widths
+    const size = tsl.rootSize(layout, pose, base).toVar(); // the instance's size scales blend widths
     Loop(count, ({ i }) => {
       const ins = programs.element(offset.add(i)).toVar();
       const op = int(ins.x).toVar();

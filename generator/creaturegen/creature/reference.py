@@ -24,10 +24,10 @@ from ..rig import CompiledRig, compile_rig
 from ..rig.graph import Ref
 from ..spec import CharacterSpec, validate_bytes
 from ..surface.asset import SurfaceAsset, read_glb
-from ..surface.deform import Pose, skin_cor, skin_dq, skin_lbs
+from ..surface.deform import Pose, posed_slots, skin_cor, skin_dq, skin_lbs
 from ..surface.skeleton import build_skeleton
 from .genome import draw_genome, genetics_data, genome_colours, slot_lab
-from .pose import sized_graph
+from .pose import sized_graph, sized_slots
 
 F64 = npt.NDArray[np.float64]
 
@@ -67,6 +67,11 @@ def instance_colours(ref: PackageReference, seed: int) -> list[list[float]]:
     """Per-slot linear rgb of the individual spawned from ``seed`` (its colour genes in OKLab)."""
     lab = slot_lab(ref.rig.slots[:, col.RGB])
     return genome_colours(genetics_data(ref.spec.genetics), lab, draw_genome(seed))
+
+
+def posed_table(ref: PackageReference, pose: Pose, size: float = 1.0) -> F64:
+    """The slot table of an individual of ``size`` in ``pose`` (what its pose rows hold, in float64)."""
+    return posed_slots(sized_slots(ref.rig.slots, size), pose)
 
 
 def field_at(ref: PackageReference, table: F64, points: F64, size: float = 1.0) -> FieldSample:

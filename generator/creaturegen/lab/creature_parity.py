@@ -39,10 +39,9 @@ from scipy import ndimage
 
 from ..creature import reference as cref
 from ..creature.genome import slot_lab
-from ..creature.pose import POSE_ROWS, as_pose, pose_rows, root_rows, sized_slots
+from ..creature.pose import POSE_ROWS, as_pose, pose_rows, root_rows
 from ..field import layout as col
 from ..motion.simulate import Motion
-from ..surface.deform import posed_slots
 from .browser import launch_lab_page
 from .png import write_png
 from .report import ParityReport
@@ -182,7 +181,7 @@ def _pose_and_field_gates(
         "size": motion.size,
         "gates": motion.gates.as_dict(),
     }
-    table = posed_slots(sized_slots(ref.rig.slots, motion.size), as_pose(motion.quats, motion.trans))
+    table = cref.posed_table(ref, as_pose(motion.quats, motion.trans), motion.size)
     points = cref.probe_points(table, cref.blend_pairs(ref.rig), PROBE_POINTS)
     raw = page.evaluate("(p) => window.__lab.probeField(p)", points.reshape(-1).tolist())
     gpu = np.asarray(raw, dtype=np.float64).reshape(-1, 4)
@@ -241,7 +240,7 @@ def _motion_gates(page: Page, ref: cref.PackageReference, motion: Motion, report
 def _skin_gates(page: Page, ref: cref.PackageReference, motion: Motion, report: ParityReport) -> None:
     scale = ref.rig.body_scale
     pose = as_pose(motion.quats, motion.trans)
-    table = posed_slots(sized_slots(ref.rig.slots, motion.size), pose)
+    table = cref.posed_table(ref, pose, motion.size)
     got = page.evaluate("() => window.__lab.readSkinned(0)")
     skinned = _b64_floats(got["skinned"]).reshape(-1, 3).astype(np.float64)
     corrected = _b64_floats(got["corrected"]).reshape(-1, 3).astype(np.float64)

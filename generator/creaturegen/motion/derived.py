@@ -62,7 +62,7 @@ def derive(data: dict[str, Any], gravity: list[float]) -> Derived:
         # windows, so a steady gait lifts each group right as its window opens. The stance is rounded
         # up with one whole tick to spare: on the curved path the lag grows along a chord, a little
         # slower than v·t, and a stance that filled its windows exactly missed its lift by a hair and
-        # waited a whole cycle (the quadruped at size +8% then lagged past its reach for 208 leg-ticks).
+        # waited a whole cycle, its foot lagging past its reach (the quadruped at the large size corner).
         stance = 0
         if speed > 0.0:
             stance = math.floor((1.0 + c["stepLead"]) * data["stepLength"] / (speed * dt)) + 2

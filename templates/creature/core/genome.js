@@ -112,9 +112,9 @@ export function expressSize(motion, size) {
 /**
  * The motion data of an individual: its size first, then its gait genes (creaturegen's express), as one
  * fresh copy built by JSON.parse. Copies made by spread-and-assign and Array.map left some legs' fields and
- * arrays in layouts whose loads box doubles in the hot step (288 B per quadruped step, measured by
- * bench/motion.mjs); JSON.parse builds V8's fast packed layouts, and the step allocates nothing again.
- * The round trip is exact: CREATURE.motion holds only finite numbers and no -0 (creaturegen motion/rig.py),
+ * arrays in layouts whose loads box doubles in the hot step (tests/test_motion.py's allocation probe saw it
+ * on the quadruped, hexapod and lizard); JSON.parse builds V8's fast packed layouts, and the step allocates
+ * nothing again. The round trip is exact: CREATURE.motion holds only finite numbers and no -0 (creaturegen motion/rig.py),
  * and the size and gait factors are positive. Spawn-time only.
  */
 export function express(motion, genome) {

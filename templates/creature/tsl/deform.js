@@ -6,7 +6,7 @@
 // vertex on a rasteriser without a post-transform cache, such as SwiftShader).
 import { Fn, If, float, instanceIndex, instancedArray, int, storage, uniform, vec4 } from 'three/tsl';
 import { CREATURE } from '../core/data.js';
-import { bodyVertex, rootSize } from './body.js';
+import { bodyVertex } from './body.js';
 
 /** vec4 per drawn vertex: (position, distance), (gradient, accepted), (albedo, program); the plan's number,
  * which the build report's deformBytesPerBody also uses. */
@@ -68,8 +68,7 @@ export function createDeformKernel(layout, fns, { pose, records, deform, size, v
     const base = j.mul(rowsPerInstance).toVar();
     const alive = pose.element(base.add(layout.slotCount * layout.rows)).w;
     If(alive.greaterThan(0.5), () => {
-      const size = rootSize(layout, pose, base);
-      const body = bodyVertex(layout, fns, { ...recordInputs(records, v), base, size, skinOnly, colour: true });
+      const body = bodyVertex(layout, fns, { ...recordInputs(records, v), base, skinOnly, colour: true });
       const o = idx.mul(DEFORM_STRIDE).toVar();
       deform.element(o).assign(vec4(body.position, body.distance));
       deform.element(o.add(1)).assign(vec4(body.gradient, body.accepted));

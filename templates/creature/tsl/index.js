@@ -1,8 +1,8 @@
 // Three/TSL adapter: pose pages, field programs, skinning, the deform pre-pass, materials, population,
 // the diagnostic shell, diagnostics.
-export { OP, createField } from './field.js';
+export { OP, createField, rootSize } from './field.js';
 export { METHOD, createSkin, rotate } from './skin.js';
-export { bodyFunctions, bodyVertex, layoutOf, rootSize } from './body.js';
+export { bodyFunctions, bodyVertex, layoutOf } from './body.js';
 export {
   DEFORM_STRIDE, RECORD_STRIDE, createDeformKernel, deformStorage, deformView, dispatchDeform, recordInputs, vertexRecords,
 } from './deform.js';

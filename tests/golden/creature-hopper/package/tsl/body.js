@@ -39,20 +39,14 @@ export function bodyFunctions(layout, pose, programs) {
   return { field, skin };
 }
 
-/** The size of the instance whose rows start at `base` (root row 1 .w). */
-export function rootSize(layout, pose, base) {
-  return pose.element(base.add(layout.slotCount * layout.rows + 1)).w;
-}
-
 /**
  * One vertex through the whole body path, inline in a Fn: skin, correct (unless skin-only), then one
  * field evaluation at the final position for the normal, the distance and (with `colour`) the albedo.
- * Inputs are nodes so the vertex stage (attributes) and the diagnostics kernels (storage) share it;
- * `size` is the instance's (rootSize).
+ * Inputs are nodes so the vertex stage (attributes) and the diagnostics kernels (storage) share it.
  */
-export function bodyVertex(layout, fns, { rest, slots, weights, skin, cor, base, size, skinOnly, colour = false }) {
+export function bodyVertex(layout, fns, { rest, slots, weights, skin, cor, base, skinOnly, colour = false }) {
   const program = select(skin.z.greaterThan(layout.noProgram - 0.5), int(layout.fullProgram), int(skin.z)).toVar();
-  const s = float(size).toVar();
+  const s = fns.field.size(base).toVar();
   const skinned = fns.skin.skinVertex(rest.mul(s), base, slots, weights, skin.x, cor.mul(s)).toVar();
   const corrected = skinOnly ? { position: skinned, accepted: float(0) } : fns.skin.correctVertex(skinned, base, program, skin.y.mul(s));
   // One evaluation at the final position: the normal's gradient, the distance and (display) the colour.

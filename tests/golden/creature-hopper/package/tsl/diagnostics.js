@@ -3,7 +3,7 @@
 // the material (field programs, skinning, correction), with results read back from the GPU. Kernels and
 // their buffers are created on first use, never by spawn or render.
 import { Fn, instanceIndex, instancedArray, int, uniform, vec4 } from 'three/tsl';
-import { bodyFunctions, bodyVertex, rootSize } from './body.js';
+import { bodyFunctions, bodyVertex } from './body.js';
 import { DEFORM_STRIDE, recordInputs } from './deform.js';
 
 export function createDiagnostics(renderer, population, { maxPoints = 8192 } = {}) {
@@ -22,8 +22,7 @@ export function createDiagnostics(renderer, population, { maxPoints = 8192 } = {
       return Fn(() => {
         const i = int(instanceIndex);
         const base = instance.mul(rowsPerInstance).toVar();
-        const size = rootSize(layout, page.pose, base);
-        const body = bodyVertex(layout, fns, { ...recordInputs(population.records, i), base, size, skinOnly: false });
+        const body = bodyVertex(layout, fns, { ...recordInputs(population.records, i), base, skinOnly: false });
         out.element(i.mul(3)).assign(vec4(body.skinned, 0));
         out.element(i.mul(3).add(1)).assign(vec4(body.position, body.accepted));
         out.element(i.mul(3).add(2)).assign(vec4(body.gradient, body.distance));

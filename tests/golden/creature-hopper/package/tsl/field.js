@@ -32,6 +32,11 @@ function perpendicular(axis) {
  * (a, ra), (b, rb), (k, rgb), quaternion, (t, roundCone). `programs` is a vec4 storage node: program
  * headers (offset, count, 0, 0) first, then instructions. `registers` bounds the register file (K).
  */
+/** The size of the instance whose rows start at `base`: root row 1 .w (core/pose.js writeRootRows). */
+export function rootSize({ slotCount, rows }, pose, base) {
+  return pose.element(base.add(slotCount * rows + 1)).w;
+}
+
 export function createField({ pose, programs, rows, slotCount, registers, gradientFloor, tiny }) {
   if (!Number.isInteger(slotCount) || slotCount < 1) throw new Error(`createField: slotCount must be a positive integer (got ${slotCount})`);
   // primitives._Frame and both distance forms, with their gradients. Returns vec4(d, ∇d).
@@ -107,7 +112,7 @@ export function createField({ pose, programs, rows, slotCount, registers, gradie
    */
   const evaluate = (p, base, program, { colour = false, kFloor = 0 } = {}) => {
     // The instance's size (root row 1 .w): blend widths scale with the body (the slot rows already do).
-    const size = pose.element(base.add(slotCount * rows + 1)).w.toVar();
+    const size = rootSize({ slotCount, rows }, pose, base).toVar();
     const header = programs.element(program);
     const offset = int(header.x).toVar();
     const count = int(header.y).toVar();
@@ -163,7 +168,10 @@ export function createField({ pose, programs, rows, slotCount, registers, gradie
   /** vec4(d, ∇d) of program `program` at `p` (evaluate without the colour). */
   const runProgram = Fn(([p, base, program]) => evaluate(p, base, program).value);
 
-  return { slotField, evaluate, runProgram };
+  /** The instance's size (the body path scales its rest vertex, centre of rotation and trust radius). */
+  const size = (base) => rootSize({ slotCount, rows }, pose, base);
+
+  return { slotField, evaluate, runProgram, size };
 }
 
 
