@@ -58,7 +58,7 @@ from creaturegen.surface.field64 import BodyField
 from creaturegen.surface.gates import SurfaceGate
 from creaturegen.surface.grid import ERROR_TARGET, Grid, GridTooFineError, make_grid, smallest_radius
 from creaturegen.surface.sampling import SIGN_SETTLE_FACTOR, NarrowBand, sample_band
-from creaturegen.surface.skeleton import build_skeleton
+from creaturegen.surface.skeleton import Skeleton, build_skeleton
 
 T = TypeVar("T")
 
@@ -152,7 +152,7 @@ def relative_example(path: Path) -> str:
 def measure_tier(
     spec: CharacterSpec,
     rig: CompiledRig,
-    names: tuple[str, ...],
+    skeleton: Skeleton,
     backends: dict[str, FieldBackend],
     tier: str,
     repeats: int,
@@ -267,7 +267,7 @@ def measure_tier(
     mesh = ex.mesh
 
     def validate() -> tuple[list[SurfaceGate], ComponentPolicy]:
-        return surface_mesh_gates(rig, ex, field, names, grid.spacing)
+        return surface_mesh_gates(rig, ex, field, skeleton, grid.spacing)
 
     t_validate, (gates, policy) = _timed(validate)
     failed = [g.name for g in gates if not g.passed]
@@ -332,7 +332,7 @@ def measure_example(
     spec = load_spec(path)
     assert isinstance(spec, CharacterSpec), f"{path} is not a creature spec"
     rig = compile_rig(spec)
-    names = build_skeleton(spec, rig).names
+    skeleton = build_skeleton(spec, rig)
     backends: dict[str, FieldBackend] = {"numpy": NumpyBackend(rig.graph, rig.slots)}
     setup: dict[str, Any] = {"numpy": 0.0}
     wgpu_reason = None
@@ -356,7 +356,7 @@ def measure_example(
         "r_min_m": r_min,
         "backend_setup_seconds": setup,
         "wgpu_unavailable_reason": wgpu_reason,
-        "tiers": [measure_tier(spec, rig, names, backends, tier, repeats, log) for tier in tiers],
+        "tiers": [measure_tier(spec, rig, skeleton, backends, tier, repeats, log) for tier in tiers],
     }
 
 

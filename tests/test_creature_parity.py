@@ -4,8 +4,6 @@ job catches a wrong GPU field formula, a shadow pass that does not use the defor
 that skips the correction and a population that uploads a stale pose. Fails (never skips)
 when the browser or node_modules is missing.
 
-The beetle is left out: its surface fails the euler gate at the hero tier (see test_surface_build.py).
-
 Every gate runs on every example, the 50-spawn population frame included: the deform pre-pass runs each
 body's vertex path once per tick (about 0.06 s per hopper body on SwiftShader, bench/runtime), so the
 51-body frame costs seconds.

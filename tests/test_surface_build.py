@@ -1,9 +1,6 @@
 """The surface stage end to end on every conformance creature: sampling, extraction, every gate, skin
-weights, the deformation choice, the bounded correction, the asset, the cache and the CLI.
-
-The beetle is left out of this suite on purpose: at the hero tier its mesh has a genus-1 handle (an
-antenna touching the shell closes a loop), so the euler gate fails by design after the build has
-extracted the body twice (~4 min on 2 cores); `creaturegen build examples/beetle.json` reports it.
+weights, the deformation choice, the bounded correction, the asset, the cache and the CLI. A body whose
+parts close a loop is refused by name in tests/test_surface_handles.py.
 """
 
 from __future__ import annotations

@@ -1,23 +1,23 @@
 """Skin weights: every gate passes on real creatures, and the barrier gate fails when the barrier is off.
 
 The examples cover legs touching the shell (beetle), knees buried in the body and a rope tail
-(quadruped), a long tapering rope tail with legs (lizard) and wings (moth). The barrier counter-example
-is a small creature built here: two claws, siblings under one body, whose tips touch.
+(quadruped), a long tapering rope tail with legs (lizard) and wings (moth); the tangled beetle fixture
+has legs touching each other. The barrier counter-example is the pincer fixture: two claws, siblings
+under one body, whose tips touch.
 """
 
 from __future__ import annotations
 
-import json
 from dataclasses import dataclass
 from functools import cache
-from typing import Any
+from pathlib import Path
 
 import numpy as np
 import pytest
 
 from conftest import EXAMPLES
 from creaturegen.rig import compile_rig
-from creaturegen.spec import CharacterSpec, load_spec, validate_bytes
+from creaturegen.spec import CharacterSpec, load_spec
 from creaturegen.surface.backends import NumpyBackend
 from creaturegen.surface.extract import extract
 from creaturegen.surface.field64 import BodyField
@@ -29,40 +29,11 @@ from creaturegen.surface.weights import LEAKAGE_MAX, SkinWeights, neighbour_matr
 
 EXAMPLE_NAMES = ["beetle.json", "reference/quadruped.json", "lizard.json", "moth.json"]
 
-PINCER: dict[str, Any] = {
-    "name": "Pincer",
-    "seed": 1,
-    "scale": 1,
-    "parts": [
-        {
-            "id": "body",
-            "shape": "capsule",
-            "a": [0, 0.3, -0.2],
-            "b": [0, 0.3, 0.1],
-            "r": 0.16,
-            "color": "#808080",
-        },
-        # Child coordinates are relative to the parent's a end; the two tips meet at x = ±0.03.
-        {
-            "id": "claw-left",
-            "shape": "capsule",
-            "parent": "body",
-            "a": [0.14, 0.0, 0.25],
-            "b": [0.03, 0.0, 0.62],
-            "r": 0.05,
-            "color": "#a0a0a0",
-        },
-        {
-            "id": "claw-right",
-            "shape": "capsule",
-            "parent": "body",
-            "a": [-0.14, 0.0, 0.25],
-            "b": [-0.03, 0.0, 0.62],
-            "r": 0.05,
-            "color": "#a0a0a0",
-        },
-    ],
-}
+#: A body with two claws whose tips meet (x = ±0.03 at the tips, r = 0.05): skeleton non-neighbours in
+#: contact. Its surface is a torus; tests/test_surface_handles.py checks the euler gate names the claws.
+PINCER = Path(__file__).parent / "fixtures" / "pincer.json"
+#: The beetle example before its legs were spread: on each side the legs touch each other.
+TANGLED = Path(__file__).parent / "fixtures" / "tangled-beetle.json"
 
 
 @dataclass(frozen=True)
@@ -82,6 +53,7 @@ def _surface(spec: CharacterSpec, tier: str) -> Surface:
 
 @cache
 def example(name: str) -> Surface:
+    """A spec under examples/, or an absolute path (the fixtures), at the repeated tier."""
     spec = load_spec(EXAMPLES / name)
     assert isinstance(spec, CharacterSpec)
     return _surface(spec, "repeated")
@@ -95,7 +67,7 @@ def weights_of(name: str) -> SkinWeights:
 
 @cache
 def pincer() -> Surface:
-    spec = validate_bytes(json.dumps(PINCER).encode())
+    spec = load_spec(PINCER)
     assert isinstance(spec, CharacterSpec)
     return _surface(spec, "hero")
 
@@ -164,10 +136,10 @@ def test_partition_of_unity_survives_heavy_pruning() -> None:
 
 
 def test_beetle_contacts_are_cut_apart() -> None:
-    """At rest the beetle's legs on one side touch each other (siblings under the shell) and its
+    """At rest the tangled beetle's legs on one side touch each other (siblings under the shell) and its
     antennae touch the shell (their grandparent): none of these pairs are skeleton neighbours."""
-    s = example("beetle.json")
-    w = weights_of("beetle.json")
+    s = example(str(TANGLED))
+    w = weights_of(str(TANGLED))
     near = neighbour_matrix(s.skeleton)
     edges = np.sort(s.mesh.edges(), axis=1)
     a, b = w.owner[edges[:, 0]], w.owner[edges[:, 1]]

@@ -11,7 +11,7 @@ from __future__ import annotations
 import sys
 import time
 from collections.abc import Callable
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 import numpy as np
@@ -40,6 +40,7 @@ from .extract import Extraction, extract
 from .field64 import BodyField
 from .gates import DISTANCE_TOL, Direction, SurfaceGate, mesh_gates
 from .grid import Grid, make_grid
+from .handles import handle_contacts
 from .mesh import Mesh
 from .sampling import sample_band
 from .skeleton import Skeleton, build_skeleton
@@ -260,10 +261,12 @@ def _fail_on(gates: list[SurfaceGate], where: str) -> None:
 
 
 def surface_mesh_gates(
-    rig: CompiledRig, ex: Extraction, rest_field: BodyField, names: tuple[str, ...], spacing: float
+    rig: CompiledRig, ex: Extraction, rest_field: BodyField, skeleton: Skeleton, spacing: float
 ) -> tuple[list[SurfaceGate], ComponentPolicy]:
     """Every mesh gate at the pipeline's thresholds, plus the component policy's (one list for the
-    build and bench/surface, so both judge a mesh the same way)."""
+    build and bench/surface, so both judge a mesh the same way). When the euler gate fails, the policy
+    carries the contacts that close the handles and the gate's detail names them."""
+    names = skeleton.names
     policy = component_policy(ex.mesh, rig.slots, rig.graph, names)
     gates = mesh_gates(
         ex.mesh,
@@ -277,9 +280,12 @@ def surface_mesh_gates(
         smooth=rest_field.smooth(CREASE_BAND_CELLS * spacing),
     )
     strays = f"components {list(policy.strays)} own no slot" if policy.strays else ""
-    gates = [
-        _name_parts(g, ex.mesh, policy, names) if g.name == "euler" and not g.passed else g for g in gates
-    ]
+    euler = next(g for g in gates if g.name == "euler")
+    if not euler.passed:
+        distances = rest_field.slot_distances(ex.mesh.vertices)
+        found = handle_contacts(ex.mesh, distances, rest_field.distance, skeleton, rig.slots, rig.slot_parts)
+        policy = replace(policy, handles=found)
+        gates = [_name_parts(g, ex.mesh, policy, names) if g is euler else g for g in gates]
     gates += [
         SurfaceGate("strayComponents", float(len(policy.strays)), 0.0, "components", "max", strays),
         SurfaceGate(
@@ -298,9 +304,17 @@ def surface_mesh_gates(
 def _name_parts(
     gate: SurfaceGate, mesh: Mesh, policy: ComponentPolicy, names: tuple[str, ...]
 ) -> SurfaceGate:
-    """The euler gate's detail rewritten to name the parts of every component that is not a sphere."""
+    """The euler gate's detail rewritten to name the contacts that close the handles (the parts to move)
+    and, failing that, the parts of every component that is not a sphere."""
     found = components(mesh)
     bad = [c for c in range(found.count) if int(found.euler[c]) != 2]
+    culprits = [c for c in policy.handles if not c.joined]
+    if culprits:
+        genus = sum(float(found.genus[c]) for c in bad)
+        detail = f"genus {genus:g}, expected 0 (the skeleton is a tree): " + "; ".join(
+            c.describe() for c in culprits
+        )
+        return SurfaceGate(gate.name, gate.value, gate.threshold, gate.unit, gate.direction, detail)
     parts = []
     for c in bad:
         owned = ", ".join(n for n, o in zip(names, policy.owners, strict=True) if o == c)
@@ -346,7 +360,7 @@ def validated_mesh(
         timings["extraction"] += time.perf_counter() - t
         progress(f"extracted {mesh.vertex_count:,} vertices, {mesh.face_count:,} triangles")
         t = time.perf_counter()
-        gates, policy = surface_mesh_gates(rig, ex, rest_field, skeleton.names, grid.spacing)
+        gates, policy = surface_mesh_gates(rig, ex, rest_field, skeleton, grid.spacing)
         timings["validation"] += time.perf_counter() - t
         failed = [g.name for g in gates if not g.passed]
         progress(
@@ -354,6 +368,9 @@ def validated_mesh(
             + (f"; failed {failed}" if failed else "")
         )
         if not failed or refinement == MAX_REFINEMENTS:
+            break
+        if failed == ["euler"] and policy.handles_certain:
+            progress("the field itself closes these handles: a finer lattice cannot open them")
             break
         progress("refining the lattice by √2 and extracting again")
     sampling = SamplingReport(

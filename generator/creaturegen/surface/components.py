@@ -22,6 +22,7 @@ import numpy.typing as npt
 
 from ..field import layout as col
 from ..rig.graph import BlendGraph, Ref
+from .handles import Contact
 from .mesh import Mesh
 from .topology import components
 
@@ -36,6 +37,13 @@ class ComponentPolicy:
     split_roots: tuple[str, ...]  # "part.<id>" of roots whose slots lie in more than one component
     detached: tuple[str, ...]  # "part.<id>" of the first slot of every component but a root's first
     unowned_slots: tuple[str, ...]  # slots no component encloses
+    handles: tuple[Contact, ...] = ()  # contacts closing a handle (looked for only when euler fails)
+
+    @property
+    def handles_certain(self) -> bool:
+        """Some part pair closes a handle that any lattice would show (surface/handles.py), so the euler
+        gate fails at every refinement."""
+        return any(c.certain for c in self.handles)
 
     @property
     def expected(self) -> int:

@@ -105,13 +105,9 @@ def edge_report(mesh: Mesh, table: EdgeTable | None = None) -> EdgeReport:
     )
 
 
-def vertex_fans(mesh: Mesh, table: EdgeTable | None = None) -> I64:
-    """Number of fans (corner groups joined across shared edges) at each vertex; manifold means one.
-
-    Two corners at vertex v belong to the same fan when their faces share an edge incident to v. Two
-    cones touching at their apexes, or two sheets sharing a single vertex, give that vertex two fans even
-    though every edge is fine, which is why this check exists beside the edge checks.
-    """
+def corner_fans(mesh: Mesh, table: EdgeTable | None = None) -> I64:
+    """Fan label of every corner (3F, face-major): corners at one vertex whose faces are joined across
+    edges incident to that vertex share a label; a vertex has as many labels as it has fans."""
     t = table if table is not None else edge_table(mesh.faces)
     f = np.asarray(mesh.faces, dtype=np.int64)
     nf = f.shape[0]
@@ -129,9 +125,22 @@ def vertex_fans(mesh: Mesh, table: EdgeTable | None = None) -> I64:
     n = 3 * nf
     graph = coo_matrix((np.ones(a.size, dtype=np.int8), (a, b)), shape=(n, n)).tocsr()
     _, fan = connected_components(graph, directed=False)
-    fan_vertex = f.reshape(-1)
-    pairs = np.unique(fan_vertex * max(n, 1) + fan)
-    counts: I64 = np.bincount(pairs // max(n, 1), minlength=mesh.vertex_count).astype(np.int64)
+    result: I64 = fan.astype(np.int64)
+    return result
+
+
+def vertex_fans(mesh: Mesh, table: EdgeTable | None = None) -> I64:
+    """Number of fans (corner groups joined across shared edges) at each vertex; manifold means one.
+
+    Two corners at vertex v belong to the same fan when their faces share an edge incident to v. Two
+    cones touching at their apexes, or two sheets sharing a single vertex, give that vertex two fans even
+    though every edge is fine, which is why this check exists beside the edge checks.
+    """
+    fan = corner_fans(mesh, table)
+    n = max(fan.size, 1)
+    fan_vertex = np.asarray(mesh.faces, dtype=np.int64).reshape(-1)
+    pairs = np.unique(fan_vertex * n + fan)
+    counts: I64 = np.bincount(pairs // n, minlength=mesh.vertex_count).astype(np.int64)
     return counts
 
 

@@ -2940,7 +2940,7 @@ export const CREATURE = Object.freeze({
     0
   ],
   "signatures": {
-    "compilerSignature": "fae9b3e41e674091e649b291bc4095fcce462a25f826c7bd3782a8c7dc6072fb",
+    "compilerSignature": "cd5ee8eee0ad2d3dc0d0517e461ed504c9fa4e36f1451a61e25f1f6fdbee629c",
     "geometryDigest": "400b0d18a2a9f6bbbfe5b441f89767f552a4f3b4c45a368d1129d632e1d2f4f1",
     "topologySignature": "5dc1330d82638a76baa5a5e186b089ecf086f1e0e101eb660242231ce0bbb29d"
   },

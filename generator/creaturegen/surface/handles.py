@@ -1,0 +1,172 @@
+"""Which contacts close the mesh's handles, so a failed euler gate names the parts to move.
+
+A creature's skeleton is a tree, so each body component should be a sphere: a handle means two parts
+touch somewhere other than the joint that connects them, closing a loop through the skeleton (two legs
+on one side whose knees overlap, an antenna resting on the shell far from the head). The mesh is right
+to show it, because the field has it, but a skinned mesh would then stretch a web between parts that
+move apart, so the build refuses it and says where.
+
+Each vertex is labelled with its nearest slot. The faces where two labels meet are that pair's contact.
+Cutting a contact out of the surface lowers the genus exactly when it runs around a handle; among the
+pairs whose cut lowers it, those that are not skeleton neighbours are the culprits (a joint on the loop
+lowers the genus too when cut, but it is where the part is meant to attach). A culprit is *certain* when
+the field is negative all along the segment joining the two parts' nearest primitives (checked at
+samples, with the Lipschitz bound covering the gaps between them): the body then holds a path from one
+part to the other at every lattice spacing, and refining the lattice cannot remove the handle.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass
+
+import numpy as np
+import numpy.typing as npt
+from scipy.sparse import coo_matrix
+from scipy.sparse.csgraph import connected_components
+
+from ..field import layout as col
+from .grid import LIPSCHITZ_BOUND
+from .mesh import Mesh
+from .skeleton import Skeleton
+from .topology import components, corner_fans, edge_table
+
+F64 = npt.NDArray[np.float64]
+I64 = npt.NDArray[np.int64]
+DistanceFn = Callable[[F64], F64]
+
+#: Samples along the segment between two parts' nearest primitives when testing the bridge.
+BRIDGE_SAMPLES = 65
+
+
+@dataclass(frozen=True)
+class Contact:
+    """Two slots whose contact runs around a handle."""
+
+    a: str
+    b: str
+    genus_drop: float  # how much cutting this contact out lowers the surface's genus
+    joined: bool  # skeleton neighbours: the contact is their joint
+    gap: float  # primitive-to-primitive distance at rest, m (negative: they overlap by that much)
+    bridge: float  # bound on the field's largest value along the segment between the primitives, m
+
+    @property
+    def certain(self) -> bool:
+        """The body holds a path between the two parts at any lattice spacing."""
+        return not self.joined and self.bridge < 0.0
+
+    def describe(self) -> str:
+        how = (
+            f"their primitives overlap by {-self.gap:.3g} m"
+            if self.gap < 0
+            else f"the blend bridges the {self.gap:.3g} m between their primitives"
+        )
+        joint = "their joint" if self.joined else "not joined in the skeleton"
+        return f"{self.a} touches {self.b} ({joint}; {how} at rest)"
+
+
+def surface_genus(mesh: Mesh) -> float:
+    """Total genus of a triangle set that may have boundaries and pinch vertices.
+
+    Every vertex counts once per fan, as if split (a cut strip often leaves a pinch), and the boundary
+    count is the cycle rank of the boundary edges over those split vertices, so g = Σ (2c − χ − b)/2
+    holds for the cut surfaces measured here.
+    """
+    if mesh.faces.shape[0] == 0:
+        return 0.0
+    table = edge_table(mesh.faces)
+    found = components(mesh, table)
+    fan = corner_fans(mesh, table)
+    fans = np.unique(fan).size
+    chi = fans - int(table.valence.size) + int(mesh.faces.shape[0])
+    half = np.flatnonzero(table.valence[table.edge_of_half] == 1)
+    loops = 0
+    if half.size:
+        nxt = 3 * (half // 3) + (half % 3 + 1) % 3
+        used, local = np.unique(np.concatenate([fan[half], fan[nxt]]), return_inverse=True)
+        graph = coo_matrix(
+            (np.ones(half.size), (local[: half.size], local[half.size :])), shape=(used.size, used.size)
+        )
+        parts, _ = connected_components(graph, directed=False)
+        loops = half.size - used.size + parts
+    return (2 * found.count - chi - loops) / 2.0
+
+
+def primitive_gap(slots: F64, i: int, j: int) -> float:
+    """Distance between two rest primitives, each taken at its smaller end radius (inside the round
+    cone, so a negative value is a certain overlap)."""
+    p, q = _closest_points(slots[i, col.A], slots[i, col.B], slots[j, col.A], slots[j, col.B])
+    ri = min(float(slots[i, col.RA]), float(slots[i, col.RB]))
+    rj = min(float(slots[j, col.RA]), float(slots[j, col.RB]))
+    return float(np.linalg.norm(p - q)) - ri - rj
+
+
+def _closest_points(p1: F64, q1: F64, p2: F64, q2: F64) -> tuple[F64, F64]:
+    """Closest points of two segments (Ericson, Real-Time Collision Detection 5.1.9)."""
+    d1, d2, r = q1 - p1, q2 - p2, p1 - p2
+    a, e, f = float(d1 @ d1), float(d2 @ d2), float(d2 @ r)
+    if a <= 1e-30 and e <= 1e-30:
+        return p1, p2
+    if a <= 1e-30:
+        return p1, p2 + np.clip(f / e, 0.0, 1.0) * d2
+    c = float(d1 @ r)
+    if e <= 1e-30:
+        return p1 + np.clip(-c / a, 0.0, 1.0) * d1, p2
+    b = float(d1 @ d2)
+    denom = a * e - b * b
+    s = float(np.clip((b * f - c * e) / denom, 0.0, 1.0)) if denom > 1e-30 else 0.0
+    t = (b * s + f) / e
+    if t < 0.0:
+        t, s = 0.0, float(np.clip(-c / a, 0.0, 1.0))
+    elif t > 1.0:
+        t, s = 1.0, float(np.clip((b - c) / a, 0.0, 1.0))
+    return p1 + s * d1, p2 + t * d2
+
+
+def bridge_bound(distance: DistanceFn, p: F64, q: F64) -> float:
+    """An upper bound on the field along segment pq: the largest sample plus the Lipschitz bound times
+    half the sample spacing."""
+    t = np.linspace(0.0, 1.0, BRIDGE_SAMPLES)[:, None]
+    step = float(np.linalg.norm(q - p)) / (BRIDGE_SAMPLES - 1)
+    return float(np.max(distance(p + t * (q - p)))) + LIPSCHITZ_BOUND * 0.5 * step
+
+
+def handle_contacts(
+    mesh: Mesh,
+    slot_distances: F64,
+    distance: DistanceFn,
+    skeleton: Skeleton,
+    slots: F64,
+    slot_parts: tuple[str, ...],
+) -> tuple[Contact, ...]:
+    """Every pair of parts whose contact runs around a handle, culprits (non-neighbours) first.
+
+    ``slot_distances`` is (S, V): each slot's own distance at each vertex (BodyField.slot_distances).
+    Labels are parts, not slots: a part's own segments meet at knees that carry no handle, and a contact that
+    spans two segments of a leg must be cut whole to open the loop it closes.
+    """
+    genus = surface_genus(mesh)
+    if genus <= 0.0:
+        return ()
+    parts = tuple(dict.fromkeys(slot_parts))
+    part_of = np.array([parts.index(p) for p in slot_parts])
+    label = part_of[np.argmin(slot_distances, axis=0)]
+    parent = {int(part_of[c]): int(part_of[p]) for p, c in skeleton.joints if part_of[p] != part_of[c]}
+    face_labels = label[mesh.faces]
+    edges = np.sort(label[mesh.edges()], axis=1)
+    found = []
+    for i, j in np.unique(edges[edges[:, 0] != edges[:, 1]], axis=0):
+        strip = np.any(face_labels == i, axis=1) & np.any(face_labels == j, axis=1)
+        drop = genus - surface_genus(Mesh(mesh.vertices, mesh.faces[~strip]))
+        if drop < 1.0:
+            continue
+        gap, a, b = min(
+            (primitive_gap(slots, int(a), int(b)), int(a), int(b))
+            for a in np.flatnonzero(part_of == i)
+            for b in np.flatnonzero(part_of == j)
+        )
+        p, q = _closest_points(slots[a, col.A], slots[a, col.B], slots[b, col.A], slots[b, col.B])
+        joined = parent.get(int(i)) == j or parent.get(int(j)) == i
+        bridge = bridge_bound(distance, p, q)
+        found.append(Contact(f"part.{parts[i]}", f"part.{parts[j]}", drop, bool(joined), gap, bridge))
+    return tuple(sorted(found, key=lambda c: (c.joined, c.gap, c.a, c.b)))
