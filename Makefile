@@ -16,8 +16,8 @@ NODE_STAMP := $(WEB_LAB)/node_modules/.package-lock.json
 # The default example is a creature (the product's spine); frost effects build the same way.
 EXAMPLE ?= examples/reference/hopper.json
 FROST_EXAMPLES := $(wildcard examples/frost/*.json)
-# Every creature example that builds; the beetle fails its surface euler gate at the hero tier (known).
-CREATURE_EXAMPLES := $(wildcard examples/reference/*.json) examples/lizard.json examples/moth.json
+# Every creature example (each builds with every gate).
+CREATURE_EXAMPLES := $(wildcard examples/reference/*.json) examples/beetle.json examples/lizard.json examples/moth.json
 LAB_HOST ?= 127.0.0.1
 LAB_PORT ?= 8765
 # Extra pytest arguments for local runs, e.g. PYTEST_ARGS='-k smoke'. CI leaves it empty: every test

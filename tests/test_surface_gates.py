@@ -164,6 +164,8 @@ def test_flipped_face_fails_winding_and_inverted(sphere: Mesh) -> None:
     gates = _gates(_with_faces(sphere, faces))
     assert gates["winding"].value == 3
     assert gates["inverted"].value == 1
+    # The gate points at the flipped face, so the build can name the part there.
+    assert np.allclose(gates["inverted"].where, sphere.vertices[sphere.faces[17]].mean(axis=0))
     assert {"winding", "inverted"} <= _failed(gates)
     assert not {"watertight", "edgeManifold", "vertexManifold", "selfIntersections"} & _failed(gates)
 
@@ -230,6 +232,9 @@ def test_tilted_coplanar_half_face_is_coincident() -> None:
 def test_hole_fails_watertight(sphere: Mesh) -> None:
     gates = _gates(_with_faces(sphere, np.delete(sphere.faces, 5, axis=0)))
     assert gates["watertight"].value == 3
+    hole = sphere.vertices[sphere.faces[5]]
+    where = np.asarray(gates["watertight"].where)
+    assert min(np.linalg.norm(where - 0.5 * (hole[i] + hole[(i + 1) % 3])) for i in range(3)) < 1e-12
     assert {"watertight", "euler"} <= _failed(gates)
     assert "edgeManifold" not in _failed(gates)
 

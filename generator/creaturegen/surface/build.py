@@ -252,7 +252,7 @@ def _fail_on(gates: list[SurfaceGate], where: str) -> None:
     failed = [g for g in gates if not g.passed]
     if failed:
         g = failed[0]
-        more = f" (and {len(failed) - 1} more)" if len(failed) > 1 else ""
+        more = f" (also failed: {', '.join(f.name for f in failed[1:])})" if len(failed) > 1 else ""
         detail = f": {g.detail}" if g.detail else ""
         raise SurfaceRejectedError(
             f"{where}: gate {g.name} = {g.value:.4g} {g.unit}, "
@@ -286,6 +286,7 @@ def surface_mesh_gates(
         found = handle_contacts(ex.mesh, distances, rest_field.distance, skeleton, rig.slots, rig.slot_parts)
         policy = replace(policy, handles=found)
         gates = [_name_parts(g, ex.mesh, policy, names) if g is euler else g for g in gates]
+    gates = [g if g.passed or g.where is None else _name_part_at(g, rest_field, names) for g in gates]
     gates += [
         SurfaceGate("strayComponents", float(len(policy.strays)), 0.0, "components", "max", strays),
         SurfaceGate(
@@ -320,6 +321,15 @@ def _name_parts(
         owned = ", ".join(n for n, o in zip(names, policy.owners, strict=True) if o == c)
         parts.append(f"genus {float(found.genus[c]):g} in the component of {owned}")
     return SurfaceGate(gate.name, gate.value, gate.threshold, gate.unit, gate.direction, "; ".join(parts))
+
+
+def _name_part_at(gate: SurfaceGate, rest_field: BodyField, names: tuple[str, ...]) -> SurfaceGate:
+    """A failed gate's detail with the part whose primitive is nearest the gate's worst point."""
+    assert gate.where is not None
+    slot = int(np.argmin(rest_field.slot_distances(np.asarray([gate.where]))[:, 0]))
+    at = ", ".join(f"{v:.4g}" for v in gate.where)
+    detail = "; ".join(x for x in (gate.detail, f"near {names[slot]} at ({at}) m") if x)
+    return replace(gate, detail=detail)
 
 
 @dataclass(frozen=True)

@@ -28,7 +28,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Literal
 
 import numpy as np
@@ -78,6 +78,9 @@ class SurfaceGate:
     unit: str
     direction: Direction = "max"
     detail: str = ""
+    #: A point where the gate is worst (or first fails), so the build can name the part there; not
+    #: stored in the sidecar, which records what was measured, not where to look.
+    where: tuple[float, float, float] | None = field(default=None, compare=False)
 
     @property
     def passed(self) -> bool:
@@ -97,8 +100,28 @@ class SurfaceGate:
         }
 
 
-def _count_gate(name: str, count: int, unit: str, detail: str) -> SurfaceGate:
-    return SurfaceGate(name, float(count), 0.0, unit, "max", detail if count else "")
+def _count_gate(name: str, count: int, unit: str, detail: str, where: F64 | None = None) -> SurfaceGate:
+    return SurfaceGate(
+        name, float(count), 0.0, unit, "max", detail if count else "", _point(where) if count else None
+    )
+
+
+def _point(p: F64 | None) -> tuple[float, float, float] | None:
+    """A gate's location as plain floats (None when there is nothing to point at)."""
+    if p is None or np.size(p) == 0:
+        return None
+    x, y, z = (float(v) for v in np.asarray(p, dtype=np.float64).reshape(-1, 3)[0])
+    return (x, y, z)
+
+
+def _at(mesh: Mesh, ids: npt.ArrayLike) -> F64 | None:
+    """Mean position of the vertices of the first row of ``ids`` (a vertex, an edge or a face)."""
+    rows = np.asarray(ids, dtype=np.int64)
+    if rows.size == 0:
+        return None
+    first = rows.reshape(rows.shape[0], -1)[0]
+    result: F64 = mesh.vertices[first].mean(axis=0)
+    return result
 
 
 def _first(ids: npt.ArrayLike, limit: int = 5) -> str:
@@ -248,14 +271,22 @@ def topology_gates(
             edges.boundary_edges,
             "edges",
             f"{edges.boundary_edges} boundary edges, first {_first(table.edges[valence == 1])}",
+            _at(mesh, table.edges[valence == 1]),
         ),
         _count_gate(
             "edgeManifold",
             edges.nonmanifold_edges,
             "edges",
             f"{edges.nonmanifold_edges} edges with >2 faces, first {_first(table.edges[valence > 2])}",
+            _at(mesh, table.edges[valence > 2]),
         ),
-        _count_gate("vertexManifold", int(bad_vertices.size), "vertices", f"first {_first(bad_vertices)}"),
+        _count_gate(
+            "vertexManifold",
+            int(bad_vertices.size),
+            "vertices",
+            f"first {_first(bad_vertices)}",
+            _at(mesh, bad_vertices),
+        ),
         _count_gate("winding", edges.winding_violations, "edges", "half-edges not paired head to tail"),
         _count_gate(
             "euler",
@@ -280,6 +311,7 @@ def topology_gates(
             int(degenerate.size),
             "faces",
             f"area < {area_eps:.3g} or repeated index; first faces {_first(degenerate)}",
+            _at(mesh, mesh.faces[degenerate]),
         ),
         SurfaceGate(
             "minAngleP1",
@@ -290,6 +322,9 @@ def topology_gates(
             f"1st-percentile smallest triangle angle {p1:.3g}° below {min_angle_bound_deg:.3g}°"
             if p1 < min_angle_bound_deg
             else "",
+            _point(_at(mesh, mesh.faces[np.argsort(topology.min_angles_deg(mesh))[:1]]))
+            if p1 < min_angle_bound_deg
+            else None,
         ),
     ]
 
@@ -307,6 +342,7 @@ def intersection_gates(mesh: Mesh, bvh: BVH) -> list[SurfaceGate]:
             "pairs",
             f"{report.intersecting} face pairs touch or cross ({report.coincident} coplanar), "
             f"first {_first(report.pairs)}",
+            _at(mesh, mesh.faces[np.asarray(report.pairs, dtype=np.int64).reshape(-1)[:1]]),
         ),
         _count_gate(
             "coincidentCoverage",
@@ -314,17 +350,34 @@ def intersection_gates(mesh: Mesh, bvh: BVH) -> list[SurfaceGate]:
             "pairs",
             f"{report.coincident} coplanar overlapping pairs (first {_first(report.coincident_pairs)}), "
             f"{dups.shape[0]} duplicate faces (first {_first(dups)})",
+            _at(
+                mesh,
+                mesh.faces[
+                    np.concatenate(
+                        [
+                            np.asarray(report.coincident_pairs, dtype=np.int64).reshape(-1)[:1],
+                            np.asarray(dups, dtype=np.int64).reshape(-1)[:1],
+                        ]
+                    )[:1]
+                ],
+            ),
         ),
     ]
 
 
-def _angle_gates(prefix: str, angles: F64, ids: I64, max_deg: float, p99_deg: float) -> list[SurfaceGate]:
+def _angle_gates(
+    prefix: str, angles: F64, ids: I64, points: F64, max_deg: float, p99_deg: float
+) -> list[SurfaceGate]:
+    """Max and p99 of the normal angles; both point at the worst one (where the tail is heaviest)."""
     worst = float(np.max(angles)) if angles.size else 0.0
     p99 = float(np.percentile(angles, 99.0)) if angles.size else 0.0
     at = int(ids[np.argmax(angles)]) if angles.size else -1
+    where = _point(points[np.argmax(angles)]) if angles.size else None
     return [
-        SurfaceGate(f"{prefix}NormalAngleMax", worst, max_deg, "deg", "max", f"worst at {prefix} {at}"),
-        SurfaceGate(f"{prefix}NormalAngleP99", p99, p99_deg, "deg", "max", ""),
+        SurfaceGate(
+            f"{prefix}NormalAngleMax", worst, max_deg, "deg", "max", f"worst at {prefix} {at}", where
+        ),
+        SurfaceGate(f"{prefix}NormalAngleP99", p99, p99_deg, "deg", "max", "", where),
     ]
 
 
@@ -367,7 +420,9 @@ def field_gates(
         coverage_detail = (
             f"{on_set.shape[0]}/{seeds.shape[0]} seeds converged; farthest at {on_set[worst].tolist()}"
         )
+        coverage_at = _point(on_set[worst])
     else:
+        coverage_at = None
         coverage = math.inf
         coverage_detail = f"no seed of {seeds.shape[0]} converged onto the zero set"
 
@@ -384,7 +439,11 @@ def field_gates(
     vmax, vp99, fmax, fp99 = normal_limits
     return [
         _count_gate(
-            "inverted", int(inverted.size), "faces", f"normal · ∇d ≤ 0 at centroid; first {_first(inverted)}"
+            "inverted",
+            int(inverted.size),
+            "faces",
+            f"normal · ∇d ≤ 0 at centroid; first {_first(inverted)}",
+            centroids[inverted[:1]],
         ),
         SurfaceGate(
             "surfaceToZeroSet",
@@ -393,8 +452,9 @@ def field_gates(
             "L",
             "max",
             f"max |d| on {samples.shape[0]} samples at face {int(owner[far]) if far >= 0 else -1}",
+            _point(samples[far]) if far >= 0 else None,
         ),
-        SurfaceGate("zeroSetToMesh", coverage, coverage_tol, "L", "max", coverage_detail),
-        *_angle_gates("vertex", vertex_angles, used, vmax, vp99),
-        *_angle_gates("face", face_angles, face_ids, fmax, fp99),
+        SurfaceGate("zeroSetToMesh", coverage, coverage_tol, "L", "max", coverage_detail, coverage_at),
+        *_angle_gates("vertex", vertex_angles, used, mesh.vertices[used], vmax, vp99),
+        *_angle_gates("face", face_angles, face_ids, feet, fmax, fp99),
     ]
