@@ -10,13 +10,21 @@ import shutil
 import subprocess
 import sys
 from collections.abc import Iterator
+from dataclasses import dataclass
 from pathlib import Path
 from types import ModuleType
 from typing import Any
 
 import pytest
 
+from creaturegen.rig import CompiledRig, compile_rig
+from creaturegen.spec import CharacterSpec, load_spec
 from creaturegen.surface.asset import exclusive
+from creaturegen.surface.backends import NumpyBackend
+from creaturegen.surface.extract import Extraction, extract
+from creaturegen.surface.field64 import BodyField
+from creaturegen.surface.grid import Grid, make_grid
+from creaturegen.surface.sampling import sample_band
 
 REPO = Path(__file__).resolve().parents[1]
 EXAMPLES = REPO / "examples"
@@ -159,3 +167,25 @@ def json_numbers(value: Any, path: str = "") -> Iterator[tuple[str, float]]:
     elif isinstance(value, list):
         for i, item in enumerate(value):
             yield from json_numbers(item, f"{path}[{i}]")
+
+
+@dataclass(frozen=True)
+class RestSurface:
+    """A creature's rest surface on the first lattice of a tier, sampled with numpy: where the surface
+    tests start (the build adds refinement, the cache and the backend choice on top)."""
+
+    spec: CharacterSpec
+    rig: CompiledRig
+    grid: Grid
+    field: BodyField
+    extraction: Extraction
+
+
+def rest_surface(path: Path, tier: str) -> RestSurface:
+    spec = load_spec(path)
+    assert isinstance(spec, CharacterSpec), f"{path} is not a creature spec"
+    rig = compile_rig(spec)
+    grid = make_grid(rig.slots, rig.graph, tier, rig.slot_parts)
+    band = sample_band(grid, NumpyBackend(rig.graph, rig.slots), rig.graph, rig.slots, rig.body_scale)
+    field = BodyField(rig.graph, rig.slots)
+    return RestSurface(spec, rig, grid, field, extract(field, band, rig.body_scale))

@@ -15,17 +15,12 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from conftest import CREATURE_EXAMPLES, EXAMPLES, REPO, run_cli
+from conftest import CREATURE_EXAMPLES, EXAMPLES, REPO, rest_surface, run_cli
 from creaturegen.rig import compile_rig
 from creaturegen.spec import CharacterSpec, load_spec
 from creaturegen.surface import build as surface_build
 from creaturegen.surface.asset import SurfaceCache, parse_glb
-from creaturegen.surface.backends import NumpyBackend
 from creaturegen.surface.build import SurfaceBuild, SurfaceRejectedError, build_surface
-from creaturegen.surface.extract import extract
-from creaturegen.surface.field64 import BodyField
-from creaturegen.surface.grid import make_grid
-from creaturegen.surface.sampling import sample_band
 from creaturegen.surface.skeleton import build_skeleton
 
 #: Parts the field itself leaves detached (rope or antenna anchored beyond the parent's surface).
@@ -113,14 +108,9 @@ def test_a_failed_gate_stops_the_build_and_names_it(monkeypatch: pytest.MonkeyPa
 def test_every_failed_mesh_gate_names_the_part_nearby() -> None:
     """The pincer's first lattice fails the distance and normal gates at the crease where its claws meet
     the body; each failed gate's detail names the part whose primitive is nearest its worst point."""
-    spec = load_spec(REPO / "tests" / "fixtures" / "pincer.json")
-    assert isinstance(spec, CharacterSpec)
-    rig = compile_rig(spec)
-    grid = make_grid(rig.slots, rig.graph, "hero", rig.slot_parts)
-    band = sample_band(grid, NumpyBackend(rig.graph, rig.slots), rig.graph, rig.slots, rig.body_scale)
-    field = BodyField(rig.graph, rig.slots)
-    ex = extract(field, band, rig.body_scale)
-    gates, _ = surface_build.surface_mesh_gates(rig, ex, field, build_skeleton(spec, rig), grid.spacing)
+    s = rest_surface(REPO / "tests" / "fixtures" / "pincer.json", "hero")
+    skeleton = build_skeleton(s.spec, s.rig)
+    gates, _ = surface_build.surface_mesh_gates(s.rig, s.extraction, s.field, skeleton, s.grid.spacing)
     failed = {g.name: g.detail for g in gates if not g.passed}
     assert {"surfaceToZeroSet", "zeroSetToMesh", "vertexNormalAngleP99"} <= set(failed), failed
     parts = ("part.body", "part.claw-left", "part.claw-right")

@@ -8,25 +8,17 @@ from functools import cache
 import numpy as np
 import pytest
 
-from conftest import EXAMPLES
+from conftest import EXAMPLES, rest_surface
 from creaturegen.field import layout as col
-from creaturegen.rig import compile_rig
-from creaturegen.spec import load_spec
-from creaturegen.surface.backends import NumpyBackend
 from creaturegen.surface.correct import DEFAULT_BUDGET, correct, trust_radius
-from creaturegen.surface.extract import Extraction, extract
+from creaturegen.surface.extract import Extraction
 from creaturegen.surface.field64 import BodyField
-from creaturegen.surface.grid import make_grid
-from creaturegen.surface.sampling import sample_band
 
 
 @cache
 def _surface(name: str) -> tuple[BodyField, Extraction, float, np.ndarray]:
-    rig = compile_rig(load_spec(EXAMPLES / name))
-    grid = make_grid(rig.slots, rig.graph, "distant", rig.slot_parts)
-    band = sample_band(grid, NumpyBackend(rig.graph, rig.slots), rig.graph, rig.slots, rig.body_scale)
-    field = BodyField(rig.graph, rig.slots)
-    ex = extract(field, band, rig.body_scale)
+    s = rest_surface(EXAMPLES / name, "distant")
+    rig, field, ex = s.rig, s.field, s.extraction
     owner = np.argmin(field.slot_distances(ex.mesh.vertices), axis=0)
     radius = np.maximum(rig.slots[owner, col.RA], rig.slots[owner, col.RB])
     return field, ex, rig.body_scale, radius

@@ -17,17 +17,12 @@ import numpy as np
 import numpy.typing as npt
 import pytest
 
-from conftest import EXAMPLES
+from conftest import EXAMPLES, rest_surface
 from creaturegen.field import layout as col
-from creaturegen.rig import CompiledRig, compile_rig
-from creaturegen.spec import CharacterSpec, load_spec
+from creaturegen.rig import CompiledRig
 from creaturegen.surface import deform
-from creaturegen.surface.backends import NumpyBackend
-from creaturegen.surface.extract import extract
 from creaturegen.surface.field64 import BodyField
-from creaturegen.surface.grid import make_grid
 from creaturegen.surface.mesh import Mesh
-from creaturegen.surface.sampling import sample_band
 from creaturegen.surface.skeleton import Skeleton, build_skeleton
 from creaturegen.surface.weights import skin_weights
 
@@ -87,16 +82,11 @@ class Body:
 
 
 def _body(path: Path) -> Body:
-    spec = load_spec(path)
-    assert isinstance(spec, CharacterSpec)
-    rig = compile_rig(spec)
-    grid = make_grid(rig.slots, rig.graph, "repeated", rig.slot_parts)
-    band = sample_band(grid, NumpyBackend(rig.graph, rig.slots), rig.graph, rig.slots, rig.body_scale)
-    field = BodyField(rig.graph, rig.slots)
-    ex = extract(field, band, rig.body_scale)
-    skeleton = build_skeleton(spec, rig)
-    weights = skin_weights(ex.mesh, field, skeleton)
-    return Body(rig, skeleton, field, ex.mesh, ex.normals, weights.indices, weights.weights)
+    s = rest_surface(path, "repeated")
+    ex = s.extraction
+    skeleton = build_skeleton(s.spec, s.rig)
+    weights = skin_weights(ex.mesh, s.field, skeleton)
+    return Body(s.rig, skeleton, s.field, ex.mesh, ex.normals, weights.indices, weights.weights)
 
 
 @pytest.fixture(scope="module")

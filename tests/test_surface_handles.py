@@ -15,18 +15,13 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from conftest import REPO, run_cli
+from conftest import REPO, rest_surface, run_cli
 from creaturegen.field import layout as col
 from creaturegen.rig import compile_rig
 from creaturegen.spec import CharacterSpec, load_spec
-from creaturegen.surface.backends import NumpyBackend
 from creaturegen.surface.build import SurfaceRejectedError, build_surface
-from creaturegen.surface.extract import extract
-from creaturegen.surface.field64 import BodyField
-from creaturegen.surface.grid import make_grid
 from creaturegen.surface.handles import Contact, handle_contacts, primitive_gap, surface_genus
 from creaturegen.surface.mesh import Mesh
-from creaturegen.surface.sampling import sample_band
 from creaturegen.surface.skeleton import build_skeleton
 
 FIXTURES = Path(__file__).parent / "fixtures"
@@ -76,16 +71,11 @@ def test_primitive_gap_is_the_segment_distance_less_the_radii() -> None:
 
 @cache
 def _contacts(path: Path, tier: str) -> tuple[float, tuple[Contact, ...]]:
-    spec = load_spec(path)
-    assert isinstance(spec, CharacterSpec)
-    rig = compile_rig(spec)
-    grid = make_grid(rig.slots, rig.graph, tier, rig.slot_parts)
-    band = sample_band(grid, NumpyBackend(rig.graph, rig.slots), rig.graph, rig.slots, rig.body_scale)
-    field = BodyField(rig.graph, rig.slots)
-    mesh = extract(field, band, rig.body_scale).mesh
+    s = rest_surface(path, tier)
+    mesh, field, rig = s.extraction.mesh, s.field, s.rig
     distances = field.slot_distances(mesh.vertices)
     found = handle_contacts(
-        mesh, distances, field.distance, build_skeleton(spec, rig), rig.slots, rig.slot_parts
+        mesh, distances, field.distance, build_skeleton(s.spec, rig), rig.slots, rig.slot_parts
     )
     return surface_genus(mesh), found
 

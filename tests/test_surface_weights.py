@@ -15,15 +15,9 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from conftest import EXAMPLES
-from creaturegen.rig import compile_rig
-from creaturegen.spec import CharacterSpec, load_spec
-from creaturegen.surface.backends import NumpyBackend
-from creaturegen.surface.extract import extract
+from conftest import EXAMPLES, rest_surface
 from creaturegen.surface.field64 import BodyField
-from creaturegen.surface.grid import make_grid
 from creaturegen.surface.mesh import Mesh
-from creaturegen.surface.sampling import sample_band
 from creaturegen.surface.skeleton import Skeleton, build_skeleton
 from creaturegen.surface.weights import LEAKAGE_MAX, SkinWeights, neighbour_matrix, skin_weights
 
@@ -43,20 +37,15 @@ class Surface:
     skeleton: Skeleton
 
 
-def _surface(spec: CharacterSpec, tier: str) -> Surface:
-    rig = compile_rig(spec)
-    grid = make_grid(rig.slots, rig.graph, tier, rig.slot_parts)
-    band = sample_band(grid, NumpyBackend(rig.graph, rig.slots), rig.graph, rig.slots, rig.body_scale)
-    field = BodyField(rig.graph, rig.slots)
-    return Surface(extract(field, band, rig.body_scale).mesh, field, build_skeleton(spec, rig))
+def _surface(path: Path, tier: str) -> Surface:
+    s = rest_surface(path, tier)
+    return Surface(s.extraction.mesh, s.field, build_skeleton(s.spec, s.rig))
 
 
 @cache
 def example(name: str) -> Surface:
     """A spec under examples/, or an absolute path (the fixtures), at the repeated tier."""
-    spec = load_spec(EXAMPLES / name)
-    assert isinstance(spec, CharacterSpec)
-    return _surface(spec, "repeated")
+    return _surface(EXAMPLES / name, "repeated")
 
 
 @cache
@@ -67,9 +56,7 @@ def weights_of(name: str) -> SkinWeights:
 
 @cache
 def pincer() -> Surface:
-    spec = load_spec(PINCER)
-    assert isinstance(spec, CharacterSpec)
-    return _surface(spec, "hero")
+    return _surface(PINCER, "hero")
 
 
 @pytest.mark.parametrize("name", EXAMPLE_NAMES)
