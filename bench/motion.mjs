@@ -1,6 +1,12 @@
 // The Node side of bench/motion.py: CPU cost and allocation of a creature package's locomotion core.
 //
-//   node --expose-gc bench/motion.mjs <package>/core/index.js '<json options>'
+//   node --expose-gc --no-concurrent-recompilation bench/motion.mjs <package>/core/index.js '<json options>'
+//
+// --no-concurrent-recompilation: V8 then optimises on the main thread, at points fixed by call counts, not
+// when its background compiler thread gets the CPU. On a loaded machine (CI beside Chromium's SwiftShader
+// threads) a starved compiler landed the optimised step after the warm-up, and every measured window timed
+// unoptimised code, which boxes every double (14 collections in one make test run; 46 per window with
+// --concurrent-recompilation-delay=1000). The steady-state code is the same; only when it arrives is fixed.
 //
 // Prints one JSON object: per-step cost (µs per creature per fixed step, median of rounds), steady-state
 // allocation (V8 heap growth and garbage collections over a run of steps, after a full collection), and,
@@ -12,8 +18,11 @@ import { pathToFileURL } from 'node:url';
 const [corePath, optionsText] = process.argv.slice(2);
 if (!corePath) throw new Error('usage: node --expose-gc bench/motion.mjs <package>/core/index.js [json options]');
 if (typeof globalThis.gc !== 'function') throw new Error('run node with --expose-gc');
+if (!process.execArgv.includes('--no-concurrent-recompilation')) {
+  throw new Error('run node with --no-concurrent-recompilation (allocation windows must not depend on the machine\'s load)');
+}
 const options = {
-  bodies: 32, warm: 300, ticks: 300, rounds: 5, allocWarm: 20000, allocSteps: 5000, allocRounds: 3, ropeConfigs: [[1, 2], [2, 4], [4, 8]],
+  bodies: 32, warm: 300, ticks: 300, rounds: 5, allocWarm: 20000, allocSteps: 5000, allocRounds: 5, ropeConfigs: [[1, 2], [2, 4], [4, 8]],
   only: null, ...JSON.parse(optionsText ?? '{}'),
 };
 const core = await import(pathToFileURL(corePath).href);
@@ -51,8 +60,9 @@ function run(m, steps) {
  * Heap growth and collections over `allocSteps` steady-state steps of one body, after `allocWarm` steps
  * through the same loop (V8 needs thousands of steps to settle its optimised code: until then unoptimised
  * code boxes every double, and compiling allocates too). `allocRounds` windows, each after a full
- * collection; the smallest growth is the steady state (a window can still catch a late background
- * compilation on a loaded machine), and every window is reported.
+ * collection; the cleanest window is the steady state (a window can still catch a late compilation), and
+ * every window is reported. Cleanest means the fewest collections, then the least growth: a collection
+ * inside a window frees memory, so its growth alone understates what the window allocated.
  */
 async function allocation(motionData) {
   const [m] = bodies(motionData, 1);
@@ -75,7 +85,8 @@ async function allocation(motionData) {
     windows.push({ heapGrowthBytes: after - before, collections: gcTimes.filter((t) => t >= start && t <= end).length });
   }
   observer.disconnect();
-  const best = windows.reduce((a, w) => (w.heapGrowthBytes < a.heapGrowthBytes ? w : a));
+  const cleaner = (w, a) => w.collections < a.collections || (w.collections === a.collections && w.heapGrowthBytes < a.heapGrowthBytes);
+  const best = windows.reduce((a, w) => (cleaner(w, a) ? w : a));
   return { steps: options.allocSteps, heapGrowthBytes: best.heapGrowthBytes, bytesPerStep: best.heapGrowthBytes / options.allocSteps, collections: best.collections, windows };
 }
 
@@ -83,7 +94,7 @@ const motion = data.motion;
 const result = {
   package: data.slug, type: motion.type, hz: motion.hz, slots: data.slotCount, legs: motion.legs.length,
   ropes: motion.ropes.map((r) => ({ part: r.part, segments: r.slots.length })),
-  node: process.version,
+  node: process.version, v8Flags: process.execArgv,
   allocation: await allocation(motion),
 };
 if (options.only !== 'allocation') result.step = stepCost(motion);

@@ -8,10 +8,11 @@ measures, in this run:
 * **step cost**: ``--bodies`` creatures (seeds 1..N, flat ground, the analytic water for a swimmer) after
   ``--warm`` steps each; ``--rounds`` rounds of ``--ticks`` steps of every body; the median µs per
   creature per step (min and max beside it);
-* **allocation**: one creature after 20000 warm-up steps, then three windows of ``--alloc-steps`` steps,
+* **allocation**: one creature after 20000 warm-up steps, then five windows of ``--alloc-steps`` steps,
   each after a full collection (``--expose-gc``): V8 heap growth (``heapUsed``) and the garbage
-  collections a ``gc`` PerformanceObserver saw start inside the window. The smallest window is reported
-  (a window can catch a late background compilation on a loaded machine), every window beside it. Zero
+  collections a ``gc`` PerformanceObserver saw start inside the window. The cleanest window (fewest
+  collections, then least growth) is reported, every window beside it. Node runs with
+  ``--no-concurrent-recompilation`` so the optimised step lands at the same point whatever the load. Zero
   bytes per step and no collection is the contract; bytes per step understate the rate when a collection
   ran in the window;
 * **ropes** (creatures with ropes): the step cost with the ropes removed and at several (substeps, passes),
@@ -91,7 +92,14 @@ def measure(package: Path, options: dict[str, Any]) -> dict[str, Any]:
     if node is None:
         raise SystemExit("bench/motion needs node on PATH")
     proc = subprocess.run(
-        [node, "--expose-gc", str(WORKER), str(package / "core" / "index.js"), json.dumps(options)],
+        [
+            node,
+            "--expose-gc",
+            "--no-concurrent-recompilation",
+            str(WORKER),
+            str(package / "core" / "index.js"),
+            json.dumps(options),
+        ],
         capture_output=True,
         text=True,
         check=False,
