@@ -18,7 +18,7 @@ from pathlib import Path
 import pytest
 
 from conftest import CREATURE_EXAMPLES, build_example
-from creaturegen.lab.creature_parity import GATE_GROUPS, run_creature_parity
+from creaturegen.lab.creature_parity import GATE_GROUPS, PAGE_SIZE, SPAWNS, run_creature_parity
 
 
 @pytest.fixture
@@ -51,7 +51,8 @@ def test_every_example_passes_every_parity_gate(name: str, out_root: Path) -> No
         "GPU-skinned vertices vs numpy",
         "silhouette vs shadow footprint",
         "drawn vertices (deform storage) vs the GPU body path",
-        "pipelines created by 50 spawns after reveal",
+        f"pipelines created by {SPAWNS} spawns after reveal",
+        f"pose pages in use after {SPAWNS} spawns of pageSize {PAGE_SIZE}",
         "pose rows (slots and root): GPU vs the Python locomotion reference",
         "planted feet in the GPU pose buffer vs their plant points",
     ):
