@@ -72,8 +72,8 @@ FOOT_DRIFT_TOL = 1e-5
 #: 65 s for 51 beetles of 65,410 vertices), and a bigger page adds nothing the gates could see.
 PAGE_SIZE = 8
 SPAWNS = PAGE_SIZE
-#: The lab's capacity: two pages, or the genetics grid's GRID_SIDE² bodies when the grid runs (the
-#: preload warms every page, one body each).
+#: Pages the burst's bodies occupy; also the lab's capacity in pages unless the genetics grid runs (its
+#: GRID_SIDE² bodies need more, and the preload warms every page, one body each, so capacity costs time).
 PAGES_IN_BURST = 2
 #: The genetics grid: side, first seed, spacing (body lengths) and the tick it is compared at.
 GRID_SIDE = 8
