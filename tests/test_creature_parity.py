@@ -4,9 +4,9 @@ job catches a wrong GPU field formula, a shadow pass that does not use the defor
 that skips the correction and a population that uploads a stale pose. Fails (never skips)
 when the browser or node_modules is missing.
 
-Every gate runs on every example, the 50-spawn population frame included: the deform pre-pass runs each
-body's vertex path once per tick (about 0.06 s per hopper body on SwiftShader, bench/runtime), so the
-51-body frame costs seconds.
+Every gate runs on every example, the spawn burst's frame included. The deform pre-pass runs each body's
+vertex path once per tick in software, so that frame's cost grows with the bodies in it (hence a burst
+of one page plus one body, creature_parity.PAGE_SIZE).
 """
 
 from __future__ import annotations

@@ -180,6 +180,9 @@ def test_duplicated_sheet_fails_duplicate_and_edge_manifold(sphere: Mesh) -> Non
     extra = sphere.faces[:40, ::-1]
     gates = _gates(_with_faces(sphere, np.concatenate([sphere.faces, extra])))
     assert {"coincidentCoverage", "edgeManifold"} <= _failed(gates)
+    # It points at one of the duplicated faces (each copy has the same centroid as its original).
+    centroids = sphere.vertices[sphere.faces[:40]].mean(axis=1)
+    assert np.min(np.linalg.norm(centroids - np.asarray(gates["coincidentCoverage"].where), axis=1)) < 1e-12
     assert topology.duplicate_faces(_with_faces(sphere, np.concatenate([sphere.faces, extra]))).shape == (
         40,
         2,

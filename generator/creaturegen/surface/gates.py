@@ -263,7 +263,8 @@ def topology_gates(
     chi = comps.euler
     off_chi = np.flatnonzero(chi != 2)
     degenerate = np.flatnonzero(topology.degenerate_faces(mesh, area_eps))
-    p1 = topology.min_angle_percentile_deg(mesh, 1.0)
+    angles = topology.min_angles_deg(mesh)
+    p1 = topology.min_angle_percentile_deg(angles, 1.0)
     components_off = abs(comps.count - expected_components)
     return [
         _count_gate(
@@ -322,9 +323,7 @@ def topology_gates(
             f"1st-percentile smallest triangle angle {p1:.3g}° below {min_angle_bound_deg:.3g}°"
             if p1 < min_angle_bound_deg
             else "",
-            _point(_at(mesh, mesh.faces[np.argsort(topology.min_angles_deg(mesh))[:1]]))
-            if p1 < min_angle_bound_deg
-            else None,
+            _point(_at(mesh, mesh.faces[[int(np.argmin(angles))]])) if p1 < min_angle_bound_deg else None,
         ),
     ]
 
@@ -352,14 +351,7 @@ def intersection_gates(mesh: Mesh, bvh: BVH) -> list[SurfaceGate]:
             f"{dups.shape[0]} duplicate faces (first {_first(dups)})",
             _at(
                 mesh,
-                mesh.faces[
-                    np.concatenate(
-                        [
-                            np.asarray(report.coincident_pairs, dtype=np.int64).reshape(-1)[:1],
-                            np.asarray(dups, dtype=np.int64).reshape(-1)[:1],
-                        ]
-                    )[:1]
-                ],
+                mesh.faces[np.r_[np.ravel(report.coincident_pairs), np.ravel(dups)][:1].astype(np.int64)],
             ),
         ),
     ]

@@ -6,7 +6,8 @@ on one side whose knees overlap, an antenna resting on the shell far from the he
 to show it, because the field has it, but a skinned mesh would then stretch a web between parts that
 move apart, so the build refuses it and says where.
 
-Each vertex is labelled with its nearest slot. The faces where two labels meet are that pair's contact.
+Each vertex is labelled with the part of its nearest slot. The faces where two labels meet are that pair's
+contact.
 Cutting a contact out of the surface lowers the genus exactly when it runs around a handle; among the
 pairs whose cut lowers it, those that are not skeleton neighbours are the culprits (a joint on the loop
 lowers the genus too when cut, but it is where the part is meant to attach). A culprit is *certain* when
@@ -41,7 +42,7 @@ BRIDGE_SAMPLES = 65
 
 @dataclass(frozen=True)
 class Contact:
-    """Two slots whose contact runs around a handle."""
+    """Two parts whose contact runs around a handle."""
 
     a: str
     b: str

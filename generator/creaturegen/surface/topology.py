@@ -222,9 +222,9 @@ def min_angles_deg(mesh: Mesh) -> F64:
     return result
 
 
-def min_angle_percentile_deg(mesh: Mesh, percentile: float = 1.0) -> float:
-    """A low percentile rather than the minimum: one sliver should not decide, a sliver tail should."""
-    angles = min_angles_deg(mesh)
+def min_angle_percentile_deg(angles: F64, percentile: float = 1.0) -> float:
+    """A low percentile of ``min_angles_deg`` rather than the minimum: one sliver should not decide, a
+    sliver tail should."""
     return float(np.percentile(angles, percentile)) if angles.size else 180.0 / 3.0
 
 

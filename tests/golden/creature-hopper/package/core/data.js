@@ -2940,7 +2940,7 @@ export const CREATURE = Object.freeze({
     0
   ],
   "signatures": {
-    "compilerSignature": "49bf8a8ec2f9ba3d1f2b9fba310d692ef725e55438cd7be6cdcc9a2d113039b8",
+    "compilerSignature": "62055a2eab1182be6ec6a4d138b60222e039e2976fd18243d82694a6194b2a6e",
     "geometryDigest": "400b0d18a2a9f6bbbfe5b441f89767f552a4f3b4c45a368d1129d632e1d2f4f1",
     "topologySignature": "5dc1330d82638a76baa5a5e186b089ecf086f1e0e101eb660242231ce0bbb29d"
   },
