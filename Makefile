@@ -26,15 +26,22 @@ PYTEST_ARGS ?=
 # pytest-xdist workers. Two fill a 2-core CI machine: much of the suite waits on Chromium, node and
 # subprocess builds, and the workers share one surface cache and one package folder (tests/conftest.py).
 PYTEST_WORKERS ?= 2
+# The generated creature corpus of `make corpus` (seeds 0 .. CORPUS_COUNT-1, every tier, builds in parallel
+# over the machine's cores; results are kept by spec, tier and compiler digest, so a rerun only builds what
+# changed). CORPUS_TIERS and CORPUS_JOBS narrow or widen it.
+CORPUS_COUNT ?= 200
+CORPUS_TIERS ?= hero,repeated,distant
+CORPUS_JOBS ?= $(shell nproc 2>/dev/null || echo 2)
 # Only folders that exist: git does not keep empty ones, and ruff fails on a missing path.
 LINT_PATHS := $(wildcard generator tests bench)
 
-.PHONY: help setup system-deps build parity test schemas lab bench golden clean distclean
+.PHONY: help setup system-deps build parity corpus test schemas lab bench golden clean distclean
 
 help:
 	@echo "make setup    .venv + pip install -e '.[dev]', npm ci in $(WEB_LAB), chromium + lavapipe"
 	@echo "make build    creaturegen build \$$EXAMPLE (now $(EXAMPLE)) into out/"
 	@echo "make parity   build every frost and creature example and run its parity job (out/<slug>/parity/)"
+	@echo "make corpus   build $(CORPUS_COUNT) generated creatures at $(CORPUS_TIERS): out/corpus/report.json, index.html"
 	@echo "make test     ruff, ruff format --check, mypy, pytest (browser tests included)"
 	@echo "make schemas  export JSON Schemas into schemas/"
 	@echo "make golden   rebuild tests/golden/ (the byte-for-byte package records); review and commit the diff"
@@ -83,6 +90,10 @@ parity: setup
 	  echo "==> creaturegen build $$spec"; $(VENV)/bin/creaturegen build $$spec >/dev/null || exit 2; \
 	  pkgs="$$pkgs out/$$($(SLUG_OF) $$spec)"; done; \
 	$(VENV)/bin/creaturegen parity $$pkgs
+
+corpus: $(VENV_STAMP)
+	@echo "==> corpus: $(CORPUS_COUNT) generated creatures at $(CORPUS_TIERS), $(CORPUS_JOBS) builds at a time"
+	$(VENV_PY) -m creaturegen.corpus --count $(CORPUS_COUNT) --tiers $(CORPUS_TIERS) --jobs $(CORPUS_JOBS) -o out/corpus
 
 schemas: $(VENV_STAMP)
 	@echo "==> exporting JSON Schemas into schemas/"

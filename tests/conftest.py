@@ -42,6 +42,16 @@ CREATURE_EXAMPLES = [
     "lizard.json",
     "moth.json",
 ]
+#: Creature specs under tests/fixtures/ that the motion tests (gates, envelope, JS core parity, allocation)
+#: run beside the examples, named ``fixtures/<file>``; the browser parity jobs do not build them.
+MOTION_FIXTURES = ["fixtures/spider.json"]
+
+
+def spec_file(name: str) -> Path:
+    """The spec a test names: ``fixtures/<file>`` under tests/, anything else under examples/."""
+    if name.startswith("fixtures/"):
+        return REPO / "tests" / name
+    return EXAMPLES / name
 
 
 @pytest.fixture
@@ -96,13 +106,13 @@ def creature_out(tmp_path_factory: pytest.TempPathFactory) -> Path:
 
 
 def build_example(name: str, out_root: Path) -> Path:
-    """examples/<name> built through the command line into ``out_root`` (once per run: a worker that
-    finds another one building it waits, then uses its package)."""
+    """examples/<name> (or a ``fixtures/`` spec, see spec_file) built through the command line into
+    ``out_root`` (once per run: a worker that finds another one building it waits, then uses its package)."""
     import json
 
     from creaturegen.spec import slugify
 
-    spec = EXAMPLES / name
+    spec = spec_file(name)
     slug = slugify(json.loads(spec.read_text())["name"])
     package = out_root / slug
     with exclusive(out_root / f".{slug}.lock"):

@@ -131,3 +131,50 @@ def test_the_sweep_reads_the_motion_and_the_certificates_contain_it() -> None:
         assert np.all(moved <= excursion + 1e-12)
     tail = [s for s, part in enumerate(rig.slot_parts) if part == "tail"]
     assert excursion[tail[-1]] > excursion[tail[0]] > 0.0, "a tail's tip swings furthest"
+
+
+def _two_leaf_colour(colour_b: tuple[float, float, float], gap: float) -> tuple[float, bool]:
+    """The colour certificate of keeping slot 0 and omitting slot 1, whose lower bound lies ``gap`` above
+    the kept upper bound (k = 0.1, so the omitted weight is e^(−gap/0.1))."""
+    from creaturegen.candidates.bounds import LeafBounds, subtree_info
+    from creaturegen.candidates.program import _colour_certificate
+    from creaturegen.field import layout as col
+    from creaturegen.rig.graph import BlendGraph
+
+    slots = np.zeros((2, col.WIDTH))
+    slots[:, col.RA] = slots[:, col.RB] = 0.1
+    slots[:, col.K] = 0.1
+    slots[0, col.RGB] = (0.5, 0.3, 0.2)
+    slots[1, col.RGB] = colour_b
+    bounds = LeafBounds(lower=np.array([-0.01, gap]), upper=np.array([0.0, 1.0]))
+    info = subtree_info(BlendGraph((), ()))
+    cert = _colour_certificate(info, bounds, slots, {0}, 0.0, 2.0**-8, 1e-6)
+    return cert.value, cert.holds
+
+
+def test_the_colour_certificate_bounds_the_colour_error_not_the_weight() -> None:
+    """An omitted leaf of the kept leaf's colour changes no colour however near it is; one of another
+    colour must be far enough that its weight times the colour difference stays under one 8-bit step."""
+    weight = float(np.exp(-0.07 / 0.1))  # ≈ 0.5: far above the old weight-only floor of 1/256
+    same, holds_same = _two_leaf_colour((0.5, 0.3, 0.2), 0.07)
+    assert same == 0.0
+    assert holds_same
+    other, holds_other = _two_leaf_colour((0.1, 0.3, 0.2), 0.07)
+    assert other == pytest.approx(weight * 0.4)
+    assert not holds_other
+    # Far enough away, the other colour's weight is negligible and the omission holds again.
+    far, holds_far = _two_leaf_colour((0.1, 0.3, 0.2), 0.6)
+    assert far <= 2.0**-8
+    assert holds_far
+    # An omitted leaf that might be the nearest one (weight sum ≥ 1) is never omitted.
+    _, holds_near = _two_leaf_colour((0.5, 0.3, 0.2), -0.05)
+    assert not holds_near
+
+
+def test_a_lower_tier_refusal_names_the_parts_and_the_remedy() -> None:
+    spec, rig = _compiled(EXAMPLES / "reference" / "quadruped.json")
+    with pytest.raises(TierRejectedError) as caught:
+        build_candidates(spec, rig, "distant")
+    message = str(caught.value)
+    assert "part." in message
+    assert "--tier hero" in message

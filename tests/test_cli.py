@@ -4,11 +4,13 @@ from __future__ import annotations
 
 import json
 from pathlib import Path
+from typing import cast
 
 import numpy as np
+import pytest
 
 from conftest import EXAMPLES, REPO, run_cli
-from creaturegen import __version__
+from creaturegen import __version__, cli
 from creaturegen.field.sampler import sample
 from creaturegen.rig import compile_rig
 from creaturegen.spec import CharacterSpec, load_spec
@@ -24,6 +26,9 @@ def test_help_lists_commands_and_exit_codes() -> None:
     assert done.returncode == 0
     for word in ("validate", "schema", "build", "Exit codes"):
         assert word in done.stdout
+    flat = " ".join(done.stdout.split())
+    assert "2 invalid spec or arguments" in flat
+    assert "3 a valid spec that a build gate refuses" in flat
 
 
 def test_no_command_is_a_usage_error() -> None:
@@ -111,3 +116,59 @@ def test_inspect_rejects_an_unknown_tier() -> None:
     done = run_cli("inspect", str(EXAMPLES / "moth.json"), "--tiers", "hero,epic")
     assert done.returncode == 2
     assert done.stderr.strip() == "--tiers: unknown tier 'epic' (known: hero, repeated, distant)"
+
+
+TANGLED = REPO / "tests" / "fixtures" / "tangled-beetle.json"
+
+
+def test_a_valid_spec_a_build_gate_refuses_exits_3_and_writes_nothing(tmp_path: Path) -> None:
+    """The tangled beetle validates (exit 0) but its legs close four handles, so the euler gate refuses
+    its surface: exit 3, not 2 (the spec is well formed; its shape must change), and nothing is written
+    (an earlier package and a user's file in the output folder are left as they were)."""
+    assert run_cli("validate", str(TANGLED)).returncode == 0
+    out = tmp_path / "out"
+    (out / "tangled-beetle").mkdir(parents=True)
+    (out / "tangled-beetle" / "index.js").write_text("// an earlier build\n")
+    (out / "notes.txt").write_text("mine")
+    before = sorted(
+        (p.relative_to(out).as_posix(), p.read_bytes() if p.is_file() else b"") for p in out.rglob("*")
+    )
+    done = run_cli("build", str(TANGLED), "-o", str(out), "--picture", "off")
+    assert done.returncode == 3, done.stdout[-2000:] + done.stderr[-2000:]
+    assert f"{TANGLED}: surface.hero: surface hero: gate euler" in done.stderr
+    assert "part.leg-front-left touches part.leg-mid-left" in done.stderr
+    assert "Traceback" not in done.stderr
+    after = sorted(
+        (p.relative_to(out).as_posix(), p.read_bytes() if p.is_file() else b"") for p in out.rglob("*")
+    )
+    assert after == before
+
+
+def test_population_short_of_n_identities_exits_3(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """--population N on a valid spec whose variants every gate refuses: the authored identity passed, so
+    the spec is valid and the refusal is a gate's, exit 3, with nothing written. The surface is stubbed:
+    which identities pass is the only thing under test here."""
+    source = EXAMPLES / "reference" / "hopper.json"
+    spec = load_spec(source)
+    assert isinstance(spec, CharacterSpec)
+
+    def identity(
+        args: object, name: str, one: CharacterSpec, data: bytes
+    ) -> cli._Identity | int:  # the authored identity passes, every variant is refused
+        if name != str(source):
+            return cli.EXIT_REFUSED
+        return cli._Identity(name, one, data, compile_rig(one), cast(cli.SurfaceBuild, None))
+
+    monkeypatch.setattr(cli, "_identity", identity)
+    out = tmp_path / "out"
+    code = cli.main(["build", str(source), "-o", str(out), "--population", "2", "--picture", "off"])
+    assert code == cli.EXIT_REFUSED == 3
+    assert "only 1 of 2 identities passed every gate in 8 draws" in capsys.readouterr().err
+    assert not out.exists()
+
+
+def test_exit_codes_are_distinct() -> None:
+    codes = (cli.EXIT_OK, cli.EXIT_GATE_FAILED, cli.EXIT_INVALID, cli.EXIT_REFUSED)
+    assert codes == (0, 1, 2, 3)

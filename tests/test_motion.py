@@ -14,7 +14,15 @@ from typing import Any
 
 import pytest
 
-from conftest import CREATURE_EXAMPLES, EXAMPLES, REPO, build_example, node, run_node_tests
+from conftest import (
+    CREATURE_EXAMPLES,
+    MOTION_FIXTURES,
+    REPO,
+    build_example,
+    node,
+    run_node_tests,
+    spec_file,
+)
 from creaturegen.motion import quat as vq
 from creaturegen.motion.envelope import corner_genomes
 from creaturegen.motion.parity import motion_reference
@@ -30,14 +38,18 @@ from creaturegen.motion.providers import (
 from creaturegen.motion.rig import WALKERS, build_motion
 from creaturegen.motion.simulate import Gates, Motion, TierRefusedError
 from creaturegen.rig import compile_rig
-from creaturegen.spec.gate import load_spec
+from creaturegen.spec import CharacterSpec
+from creaturegen.spec.gate import load_spec, validate_bytes
 from creaturegen.surface.skeleton import build_skeleton
 
 TICKS = 1000
+#: The examples and the motion fixtures (the eight-legged spider): every gate and the JS core parity run on
+#: each.
+MOTION_SPECS = [*CREATURE_EXAMPLES, *MOTION_FIXTURES]
 
 
 def motion_data(name: str) -> dict[str, Any]:
-    spec = load_spec(EXAMPLES / name)
+    spec = load_spec(spec_file(name))
     rig = compile_rig(spec)
     return build_motion(spec, rig, build_skeleton(spec, rig))
 
@@ -54,7 +66,8 @@ def assert_gates(where: str, g: Gates, data: dict[str, Any], ticks: int) -> None
     print(
         f"{where}: drift {g.plant_drift:.2e} ik {g.ik_residual:.2e} drawn {g.drawn_foot:.2e} "
         f"clamped {g.clamped_ticks} steps {g.steps} rope {g.rope_anchor:.2e} swim {g.swim_tracking:.4f}m "
-        f"apex {g.apex_error:.2e} m squash@apex {g.apex_squash!r} both-swing {g.both_swing_ticks}"
+        f"apex {g.apex_error:.2e} m squash@apex {g.apex_squash!r} both-swing {g.both_swing_ticks} "
+        f"fewest planted {g.fewest_planted} of {len(data['legs'])}"
     )
     assert g.plant_drift <= 1e-9, f"{where}: planted-foot drift {g.plant_drift:.3g} x leg length"
     assert g.ik_residual <= 1e-12, f"{where}: IK length residual {g.ik_residual:.3g}"
@@ -64,6 +77,10 @@ def assert_gates(where: str, g: Gates, data: dict[str, Any], ticks: int) -> None
         assert g.steps > 0, f"{where}: no foot ever stepped"
         assert g.planted_samples > 0
         assert g.clamped_ticks <= 0.01 * len(data["legs"]) * ticks, f"{where}: {g.clamped_ticks} clamped"
+        # One phase group swings at a time: with alternating groups half the feet are always down (the
+        # biped one, a trotting quadruped two, tripods three, the spider's tetrapods four).
+        half = len(data["legs"]) // 2
+        assert g.fewest_planted >= half, f"{where}: only {g.fewest_planted} feet planted on some tick"
     if kind == "biped":
         assert g.both_swing_ticks == 0, f"{where}: both feet in swing on {g.both_swing_ticks} ticks"
     if kind == "hopper":
@@ -74,7 +91,7 @@ def assert_gates(where: str, g: Gates, data: dict[str, Any], ticks: int) -> None
         assert 0.0 < g.swim_tracking < 0.09, f"{where}: swim tracking {g.swim_tracking:.3g} m after 2 s"
 
 
-@pytest.mark.parametrize("name", CREATURE_EXAMPLES)
+@pytest.mark.parametrize("name", MOTION_SPECS)
 def test_gates_on_every_support(name: str) -> None:
     """Also prints each support's worst values: `pytest tests/test_motion.py -k gates -s` shows them."""
     data = motion_data(name)
@@ -85,7 +102,7 @@ def test_gates_on_every_support(name: str) -> None:
 CORNER_TICKS = 600
 
 
-@pytest.mark.parametrize("name", CREATURE_EXAMPLES)
+@pytest.mark.parametrize("name", MOTION_SPECS)
 def test_gates_hold_at_the_corners_of_the_gene_box(name: str) -> None:
     """Every individual a spawn can draw moves within the gates: each gait gene and the size gene at -1 and
     at +1 (the bounds of the box every genome lies in), on flat ground. Scaling speed alone, or step length
@@ -109,7 +126,7 @@ def test_gates_hold_at_the_corners_of_the_gene_box(name: str) -> None:
 BETWEEN_SEEDS = range(100, 116)
 
 
-@pytest.mark.parametrize("name", CREATURE_EXAMPLES)
+@pytest.mark.parametrize("name", MOTION_SPECS)
 def test_gates_hold_for_spawned_genomes_between_the_corners(name: str) -> None:
     """Whole ticks quantise swing and stance, so an individual between the corners can land where no corner
     does: a stance that filled its windows exactly made a foot miss its lift by a hair and lag past its
@@ -238,7 +255,7 @@ def test_ropes_bend_without_folding_and_stay_above_the_ground(name: str) -> None
             )
 
 
-@pytest.mark.parametrize("name", CREATURE_EXAMPLES)
+@pytest.mark.parametrize("name", MOTION_SPECS)
 def test_no_slot_turns_by_a_flip_between_ticks(name: str) -> None:
     """No bone frame flips between ticks on the rotating platform: the skin follows the slots, so a frame
     that flips 180° about its own axis (as the hint-based leg frames did when a shin swung through the hint
@@ -246,7 +263,7 @@ def test_no_slot_turns_by_a_flip_between_ticks(name: str) -> None:
     tick < 60°, and every non-rope slot's whole turn per tick < 60°. A rope segment's swing is printed, not
     gated: its frame composes every turn up the chain, and the hopper's tail tip, held to its length and
     bend limit by the follow-the-leader pass, whips through close to 60° in the tick it lands."""
-    spec = load_spec(EXAMPLES / name)
+    spec = load_spec(spec_file(name))
     rig = compile_rig(spec)
     data = build_motion(spec, rig, build_skeleton(spec, rig))
     # Each slot's rest axis (a sphere has none: its whole turn is gated instead).
@@ -279,6 +296,42 @@ def test_no_slot_turns_by_a_flip_between_ticks(name: str) -> None:
     assert turn[0] < 60.0, f"{name}: slot {turn[2]} turns {turn[0]:.1f} deg at tick {turn[1]}"
 
 
+def _walker_spider(legs: int) -> dict[str, Any]:
+    """Motion data of the spider as a ``walker`` with its front ``legs`` legs (pairs front to back)."""
+    document = json.loads(spec_file("fixtures/spider.json").read_text())
+    kept = [p["id"] for p in document["parts"] if p["shape"] == "leg"][:legs]
+    document["parts"] = [p for p in document["parts"] if p["shape"] != "leg" or p["id"] in kept]
+    document["locomotion"]["type"] = "walker"
+    spec = validate_bytes(json.dumps(document).encode())
+    assert isinstance(spec, CharacterSpec)
+    rig = compile_rig(spec)
+    return build_motion(spec, rig, build_skeleton(spec, rig))
+
+
+@pytest.mark.parametrize("legs", [2, 4, 6, 8])
+def test_walkers_with_every_even_leg_count_keep_the_gates(legs: int) -> None:
+    """The generic walker on 2, 4, 6 and 8 of the spider's legs, on every support: the same gates as the
+    named walkers, half its feet always planted."""
+    data = _walker_spider(legs)
+    assert data["type"] == "walker"
+    assert len(data["legs"]) == legs
+    assert data["groups"] == 2
+    for support in builtin_supports():
+        gates = run(data, support).gates
+        assert_gates(f"walker on {legs} legs, {support}", gates, data, TICKS)
+        assert gates.fewest_planted == legs // 2
+
+
+def test_a_single_phase_group_lifts_every_foot_at_once() -> None:
+    """Why the gate is there: the gait lifts one phase group at a time, so a walker whose legs all share a
+    phase has every foot in the air at once (the spec does not forbid it; the gate shows it)."""
+    data = motion_data("fixtures/spider.json")
+    for leg in data["legs"]:
+        leg["group"] = 0
+    data["groups"] = 1
+    assert run(data, "flat", 300).gates.fewest_planted == 0
+
+
 def test_the_gates_can_fail() -> None:
     """A shin drawn 1 cm shorter than the IK solves for: the drawn foot leaves its plant, and both the
     drawn-foot and the planted-drift gates see it."""
@@ -289,7 +342,7 @@ def test_the_gates_can_fail() -> None:
     assert g.plant_drift > 1e-3
 
 
-@pytest.mark.parametrize("name", CREATURE_EXAMPLES)
+@pytest.mark.parametrize("name", MOTION_SPECS)
 def test_js_core_matches_python(name: str, creature_out: Path, tmp_path: Path) -> None:
     package = build_example(name, creature_out)
     data = motion_data(name)
@@ -300,6 +353,30 @@ def test_js_core_matches_python(name: str, creature_out: Path, tmp_path: Path) -
     done = run_node_tests("motion_core.test.mjs", env)
     assert re.search(r"\bpass 6\b", done.stdout), done.stdout
     print(f"{name}: " + "; ".join(re.findall(r"^\S+ seed \d+: worst .*$", done.stdout, re.M)))
+
+
+def test_js_core_matches_python_for_the_generic_walker_type(creature_out: Path, tmp_path: Path) -> None:
+    """``"type": "walker"`` runs the same gait as the named walkers, in both languages. The spider as a
+    walker compiles to the octopod's motion data but for its type (tests/test_walkers.py), so its package
+    with the type relabelled (a module re-exporting the core) is what a walker spider builds; the JS core
+    must still take it for a walker and match Python bit for bit."""
+    package = build_example("fixtures/spider.json", creature_out)
+    data = {**motion_data("fixtures/spider.json"), "type": "walker"}
+    reference = {**motion_reference(data), "data": data}
+    path = tmp_path / "motion-reference.json"
+    path.write_text(json.dumps(reference))
+    real = (package / "core" / "index.js").resolve().as_uri()
+    relabelled = tmp_path / "walker-core.mjs"
+    relabelled.write_text(
+        f"import * as real from {json.dumps(real)};\n"
+        f"export * from {json.dumps(real)};\n"
+        "export const CREATURE = { ...real.CREATURE, motion: { ...real.CREATURE.motion, type: 'walker' } };\n"
+    )
+    env = {"MOTION_CORE": str(relabelled), "MOTION_REFERENCE": str(path)}
+    done = run_node_tests("motion_core.test.mjs", env)
+    assert re.search(r"\bpass 6\b", done.stdout), done.stdout
+    assert all(case["gates"]["steps"] > 0 for case in reference["cases"]), "the walker never stepped"
+    print("walker spider: " + "; ".join(re.findall(r"^\S+ seed \d+: worst .*$", done.stdout, re.M)))
 
 
 #: Heap growth allowed over the measured steps: room for the probe's own bookkeeping (a few kB), far below
@@ -335,7 +412,7 @@ def windows(alloc: dict[str, Any]) -> str:
     return ", ".join(f"{w['heapGrowthBytes']} B / {w['collections']} GCs" for w in alloc["windows"])
 
 
-@pytest.mark.parametrize("name", CREATURE_EXAMPLES)
+@pytest.mark.parametrize("name", MOTION_SPECS)
 def test_steady_state_steps_do_not_allocate(name: str, creature_out: Path) -> None:
     """V8 heap growth and garbage collections over 5000 steps of one creature after a 20000-step warm-up
     and a full collection (the cleanest of five windows: the steady state, not a late compilation)."""

@@ -9,7 +9,7 @@ import math
 import numpy as np
 import pytest
 
-from conftest import CREATURE_EXAMPLES, EXAMPLES
+from conftest import CREATURE_EXAMPLES, MOTION_FIXTURES, spec_file
 from creaturegen.field import layout as col
 from creaturegen.motion import envelope
 from creaturegen.motion.providers import AnalyticWater
@@ -25,14 +25,14 @@ RANDOM_SEEDS = (101, 2024, 77777)
 
 
 def _load(name: str) -> tuple[CharacterSpec, object, dict, object]:
-    spec = load_spec(EXAMPLES / name)
+    spec = load_spec(spec_file(name))
     assert isinstance(spec, CharacterSpec)
     rig = compile_rig(spec)
     skeleton = build_skeleton(spec, rig)
     return spec, rig, build_motion(spec, rig, skeleton), skeleton
 
 
-@pytest.mark.parametrize("name", CREATURE_EXAMPLES)
+@pytest.mark.parametrize("name", [*CREATURE_EXAMPLES, *MOTION_FIXTURES])
 def test_random_individuals_stay_inside_the_widened_envelope(name: str) -> None:
     """Individuals the envelope never stepped (random seeds: their own genomes and headings) on every support
     stay inside what the sweeps certify: each slot within its excursion ball, each joint within its swept

@@ -325,3 +325,15 @@ def test_choice_never_returns_lbs_where_its_sweep_failed(
             first = next(m for m in deform.METHODS if sweeps[m].passed)
             assert joint.method == first
             assert (joint.method == "lbs") == sweeps["lbs"].passed
+
+
+def test_relative_gates_compare_with_a_method_that_keeps_the_joint() -> None:
+    """A collapsed LBS joint hugs the posed body from inside; DQ's bulge and surface error are measured
+    against the best method that keeps the joint (here CoR), not against the collapsed one."""
+    values = np.array([[0.001, 0.010, 0.006], [0.002, 0.003, 0.004]])
+    keeps = np.array([[False, True, True], [True, True, True]])
+    excess = deform._excess(values, keeps)
+    assert excess[0].tolist() == pytest.approx([0.0, 0.004, 0.0])
+    assert excess[1].tolist() == pytest.approx([0.0, 0.001, 0.002])
+    # Where no method keeps the joint, all three stay the reference (the absolute gates fail them).
+    assert np.array_equal(deform._excess(values, np.zeros_like(keeps)), deform._excess(values))

@@ -125,10 +125,11 @@ def test_the_build_names_the_contacts_and_stops_refining() -> None:
     assert any("a finer lattice cannot open them" in line for line in said), said
 
 
-def test_the_cli_exits_2_and_writes_nothing(tmp_path: Path) -> None:
+def test_the_cli_exits_3_and_writes_nothing(tmp_path: Path) -> None:
+    """A valid spec that a build gate refuses exits 3 (2 is for invalid specs and arguments)."""
     out = tmp_path / "out"
     done = run_cli("build", str(PINCER), "-o", str(out), "--picture", "off")
-    assert done.returncode == 2, done.stderr
+    assert done.returncode == 3, done.stderr
     assert "gate euler" in done.stderr
     assert "part.claw-right touches part.claw-left" in done.stderr
     assert not out.exists() or not any(out.iterdir())

@@ -175,3 +175,61 @@ def test_rejects_zero_influences() -> None:
     s = pincer()
     with pytest.raises(ValueError, match="max_influences"):
         skin_weights(s.mesh, s.field, s.skeleton, max_influences=0)
+
+
+def _planted_gates(s: Surface, still: frozenset[int]) -> dict[str, float]:
+    """The weight gates of one-hot weights on each vertex's owner: a hard seam between every two parts."""
+    from creaturegen.surface.weights import _gates, motion_groups, undirected_edges
+
+    v = s.mesh.vertex_count
+    owner = np.argmin(s.field.slot_distances(s.mesh.vertices), axis=0).astype(np.int32)
+    indices = np.repeat(owner[:, None], 4, axis=1).astype(np.int32)
+    weights = np.zeros((v, 4))
+    weights[:, 0] = 1.0
+    gates = _gates(
+        undirected_edges(s.mesh),
+        np.zeros(v, dtype=bool),
+        indices,
+        weights,
+        owner,
+        owner,
+        neighbour_matrix(s.skeleton),
+        s.skeleton,
+        [],
+        0,
+        motion_groups(s.skeleton, still),
+    )
+    return {g.name: g.value for g in gates}
+
+
+def test_continuity_reads_seams_between_parts_that_move_apart() -> None:
+    """A hard seam between two parts that move relative to each other still fails the gate; the same seam
+    between parts the motion never turns apart (one transform in every pose, so no skinning method can
+    show it) does not count."""
+    from creaturegen.surface.weights import CONTINUITY_MAX, motion_groups
+
+    s = example("lizard.json")
+    children = frozenset(child for _, child in s.skeleton.joints)
+    assert motion_groups(s.skeleton, frozenset()).tolist() == list(range(s.field.slots.shape[0]))
+    assert len(set(motion_groups(s.skeleton, children).tolist())) == 1  # one root, every joint still
+    moving = _planted_gates(s, frozenset())["weights.continuity"]
+    assert moving == 1.0 > CONTINUITY_MAX
+    assert _planted_gates(s, children)["weights.continuity"] == 0.0
+    # Only the head's joints still: the seams of the legs and the tail still fail.
+    head = frozenset(c for p, c in s.skeleton.joints if s.skeleton.names[c] in ("part.head", "part.snout"))
+    assert head
+    assert _planted_gates(s, head)["weights.continuity"] == 1.0
+
+
+def test_the_build_reads_still_joints_from_the_motion() -> None:
+    """The lizard's head and snout never turn against the body in its gait; its legs and tail do."""
+    from creaturegen.motion.envelope import pose_envelope
+    from creaturegen.rig import compile_rig
+    from creaturegen.spec import load_spec
+
+    spec = load_spec(EXAMPLES / "lizard.json")
+    rig = compile_rig(spec)
+    skeleton = build_skeleton(spec, rig)
+    still = {skeleton.names[c] for c in pose_envelope(spec, rig).still_joints(rig.body_scale)}
+    assert {"part.head", "part.snout"} <= still
+    assert not any(name.startswith(("part.leg", "part.tail")) for name in still)

@@ -1,7 +1,10 @@
 """The ``creaturegen`` command line: validate specs, export schemas, build packages.
 
-Exit codes: 0 success, 1 a parity gate failed, 2 invalid input (bad spec, bad arguments). Nothing is
-written when a spec is invalid.
+Exit codes: 0 success, 1 a parity gate failed, 2 invalid input (bad spec, bad arguments), 3 a valid spec
+that a build gate refuses (a surface gate, a grid too fine, a deformation sweep, or fewer than N identities
+of ``--population N`` passing). Nothing is written with 2 or 3. The two are kept apart because they call
+for different fixes: 2 means the spec or the command line is wrong as written; 3 means the spec is well
+formed but its geometry cannot be certified, so the creature's shape (not its syntax) has to change.
 """
 
 from __future__ import annotations
@@ -37,8 +40,9 @@ from .surface.deform import DeformationError
 from .surface.grid import GridTooFineError
 
 EXIT_OK = 0
-EXIT_INVALID = 2
 EXIT_GATE_FAILED = 1
+EXIT_INVALID = 2
+EXIT_REFUSED = 3
 
 _LINE_COLUMN = re.compile(r"^\d+:\d+$")
 
@@ -136,17 +140,17 @@ def _build(args: argparse.Namespace) -> int:
     return EXIT_OK
 
 
-def _surface(
-    name: str, spec: CharacterSpec, rig: CompiledRig, tier: str, backend: str
-) -> SurfaceBuild | None:
-    """The surface at ``tier``; every failure is printed naming the gate or part, None then."""
+def _surface(name: str, spec: CharacterSpec, rig: CompiledRig, tier: str, backend: str) -> SurfaceBuild | int:
+    """The surface at ``tier``, or the exit code of its failure, printed naming the gate, part or option:
+    EXIT_REFUSED when a gate refuses the geometry, EXIT_INVALID when ``--backend`` cannot be used."""
     try:
         return build_surface(spec, rig, tier=tier, backend=backend, cache=SurfaceCache())
     except (SurfaceRejectedError, GridTooFineError, DeformationError) as exc:
         print_errors(name, [SpecError(f"surface.{tier}", str(exc))])
+        return EXIT_REFUSED
     except ValueError as exc:
         print_errors(name, [SpecError("--backend", str(exc))])
-    return None
+        return EXIT_INVALID
 
 
 def _print_gates(build: SurfaceBuild) -> None:
@@ -167,18 +171,19 @@ class _Identity:
     build: SurfaceBuild
 
 
-def _identity(args: argparse.Namespace, name: str, spec: CharacterSpec, data: bytes) -> _Identity | None:
-    """Compile, extract and gate one identity; None (errors printed, naming the gate or part) on failure."""
+def _identity(args: argparse.Namespace, name: str, spec: CharacterSpec, data: bytes) -> _Identity | int:
+    """Compile, extract and gate one identity; on failure the exit code (errors printed, naming the gate or
+    part): EXIT_INVALID for a rig the spec cannot compile to, EXIT_REFUSED for a surface gate."""
     try:
         rig = compile_rig(spec)
     except RigCompileError as exc:
         print_errors(name, exc.errors)
-        return None
+        return EXIT_INVALID
     steps = "narrow-band sampling, extraction, gates, skin weights, deformation sweeps"
     print(f"==> surface {args.tier}: {steps}")
     build = _surface(name, spec, rig, args.tier, args.backend)
-    if build is None:
-        return None
+    if isinstance(build, int):
+        return build
     _print_gates(build)
     counts = build.sidecar["counts"]
     print(f"  mesh {counts}; " + ("cache hit" if build.cached else "extracted"))
@@ -189,14 +194,16 @@ def _identity(args: argparse.Namespace, name: str, spec: CharacterSpec, data: by
 DRAWS_PER_IDENTITY = 4
 
 
-def _identities(args: argparse.Namespace, spec: CharacterSpec, data: bytes) -> list[_Identity] | None:
+def _identities(args: argparse.Namespace, spec: CharacterSpec, data: bytes) -> list[_Identity] | int:
     """The authored identity and, with ``--population N``, N - 1 morphology variants (creature/morphology.py).
     A variant that fails validation or a surface gate is rejected (the reason printed) and the next index is
-    drawn, so identity names follow draw indices; None when the authored spec fails, or when N identities
-    do not pass within DRAWS_PER_IDENTITY·N draws."""
+    drawn, so identity names follow draw indices. On failure the exit code: the authored identity's own
+    (EXIT_INVALID or EXIT_REFUSED), EXIT_INVALID when the name leaves no room for identity suffixes, and
+    EXIT_REFUSED when N identities do not pass within DRAWS_PER_IDENTITY·N draws (the authored spec is
+    valid and built; its variants are what the gates refused)."""
     authored = _identity(args, args.spec, spec, data)
-    if authored is None:
-        return None
+    if isinstance(authored, int):
+        return authored
     out = [authored]
     document = json.loads(data)
     bound = spec.genetics.morphology
@@ -220,9 +227,9 @@ def _identities(args: argparse.Namespace, spec: CharacterSpec, data: bytes) -> l
                 name,
                 [SpecError("name", "too long for an identity suffix: the slugs of the identities collide")],
             )
-            return None
+            return EXIT_INVALID
         one = _identity(args, name, variant, variant_data) if isinstance(variant, CharacterSpec) else None
-        if one is None:
+        if not isinstance(one, _Identity):
             print(f"  identity m{index} rejected (above); drawing the next")
             continue
         out.append(one)
@@ -232,14 +239,14 @@ def _identities(args: argparse.Namespace, spec: CharacterSpec, data: bytes) -> l
             f"in {index} draws; nothing was written (lower genetics.morphology or --population)",
             file=sys.stderr,
         )
-        return None
+        return EXIT_REFUSED
     return out
 
 
 def _build_creature(args: argparse.Namespace, spec: CharacterSpec, data: bytes) -> int:
     identities = _identities(args, spec, data)
-    if identities is None:
-        return EXIT_INVALID
+    if isinstance(identities, int):
+        return identities
     print("==> package: candidate program tapes, locomotion data, templates")
     picture = args.picture == "on"
     if args.picture == "auto":
@@ -333,9 +340,10 @@ def _inspect(args: argparse.Namespace) -> int:
     surface = None
     if args.surface:
         print(f"==> surface {args.surface}", file=sys.stderr)
-        surface = _surface(args.spec, spec, rig, args.surface, args.backend)
-        if surface is None:
-            return EXIT_INVALID
+        found = _surface(args.spec, spec, rig, args.surface, args.backend)
+        if isinstance(found, int):
+            return found
+        surface = found
         report["surface"] = {
             "tier": surface.tier,
             "signatures": surface.signatures,
@@ -400,6 +408,23 @@ def _parity(args: argparse.Namespace) -> int:
     return EXIT_GATE_FAILED if failed else EXIT_OK
 
 
+def _random(args: argparse.Namespace) -> int:
+    from .corpus.random import LOCOMOTION_WEIGHTS
+    from .corpus.run import write_specs
+
+    if args.locomotion is not None and args.locomotion not in LOCOMOTION_WEIGHTS:
+        known = ", ".join(LOCOMOTION_WEIGHTS)
+        print(f"--locomotion: unknown type {args.locomotion!r} (known: {known})", file=sys.stderr)
+        return EXIT_INVALID
+    if args.count < 1:
+        print(f"--count: must be at least 1 (got {args.count})", file=sys.stderr)
+        return EXIT_INVALID
+    seeds = range(args.seed, args.seed + args.count)
+    for path in write_specs(Path(args.out), seeds, args.locomotion):
+        print(f"wrote {path}")
+    return EXIT_OK
+
+
 def _lab(args: argparse.Namespace) -> int:
     from .lab import server
 
@@ -411,7 +436,8 @@ def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(
         prog="creaturegen",
         description="Compile JSON creature and frost specs into Three.js r185 WebGPU/TSL npm packages.",
-        epilog="Exit codes: 0 ok, 1 a parity gate failed, 2 invalid spec or arguments (errors name it).",
+        epilog="Exit codes: 0 ok, 1 a parity gate failed, 2 invalid spec or arguments (errors name it), "
+        "3 a valid spec that a build gate refuses (the gate is named). Nothing is written with 2 or 3.",
     )
     parser.add_argument("--version", action="version", version=f"creaturegen {__version__}")
     commands = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
@@ -496,6 +522,19 @@ def build_parser() -> argparse.ArgumentParser:
         help="creature packages: also write the distance, normals and candidates views as PNGs",
     )
     parity.set_defaults(run=_parity)
+
+    rand = commands.add_parser(
+        "random",
+        help="write plausible random creature specs (the corpus generator), one file per seed",
+        description="Draw plausible creature specs from seeds: every locomotion type, scales 0.1 to 5, "
+        "4 to 24 parts, eyes, ears, horns, necks, rope tails, tapered and thick limbs, 8-legged walkers, "
+        "default blends, explicit trees and n-ary groups. The same seed gives the same file.",
+    )
+    rand.add_argument("--seed", type=int, default=0, help="first seed (default 0)")
+    rand.add_argument("--count", type=int, default=1, help="specs to write, seeds seed..seed+count-1")
+    rand.add_argument("--locomotion", metavar="TYPE", help="pin the locomotion type (default: drawn)")
+    rand.add_argument("-o", "--out", default="out/random", help="folder to write (default: out/random)")
+    rand.set_defaults(run=_random)
 
     lab = commands.add_parser("lab", help="serve the web lab on a fixed port and print the URLs")
     lab.add_argument("--out", default="out", help="built packages, served at /out/ (default: out)")

@@ -59,7 +59,7 @@ test('JS core matches Python after 1000 ticks on every support surface', () => {
     for (let s = 0; s < prev.q.length / 4; s++) render.push(...prev.q.subarray(4 * s, 4 * s + 4), ...prev.t.subarray(3 * s, 3 * s + 3));
     const { ratio } = worst(render, c.render.state, `${c.support} render pose`);
     assert.ok(ratio <= ref.relative, `${c.support}: interpolated render pose differs by ${ratio}`);
-    for (const key of ['steps', 'clampedTicks', 'bothSwingTicks', 'plantedSamples']) {
+    for (const key of ['steps', 'clampedTicks', 'bothSwingTicks', 'fewestPlanted', 'plantedSamples']) {
       const py = c.gates[key.replace(/[A-Z]/g, (ch) => `_${ch.toLowerCase()}`)];
       assert.equal(motion.gates[key], py, `${c.support}: gate ${key}`);
     }

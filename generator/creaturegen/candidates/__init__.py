@@ -79,7 +79,7 @@ def build_candidates(spec: CharacterSpec, rig: CompiledRig, tier: str) -> Candid
     gates = (
         Gate("surfaceError", result.surface_error, "m", tol.tail),
         Gate("normalAngle", result.normal_angle_deg, "deg", MAX_NORMAL_ANGLE_DEG),
-        Gate("omittedColourWeight", result.omitted_colour_weight, "1", tol.weight_floor),
+        Gate("omittedColourError", result.omitted_colour_error, "linear RGB", tol.weight_floor),
         Gate("deltaEOklab", result.delta_e_oklab, "1", MAX_DELTA_E_OKLAB),
     )
     failed = [g for g in gates if not g.passed]

@@ -8,8 +8,13 @@ through otherwise. Omitting is justified per sibling:
 - lse-tail: the omitted members change the group by at most k·log(1 + Σ exp(−(lower_j − ref)/k)),
   which must stay under the tail tolerance;
 - root-min: an omitted root stays above the kept roots' minimum wherever the surface can be;
-- colour-weight: the omitted leaves' proximity weights sum to at most the weight floor (geometric
-  saturation does not bound them).
+- colour-weight: the colour error the omitted leaves can cause stays under the colour floor (one 8-bit
+  quantum per linear channel; geometric saturation does not bound it). The colour is the proximity-weighted
+  mean ``Σ w_i c_i / Σ w_i``; the nearest leaf has weight 1 and is kept whenever the omitted weights sum
+  to W_O < 1, so dropping the omitted leaves moves the colour by ``W_O/(W_K + W_O)·|c̄_O − c̄_K|`` ≤
+  ``W_O · max |c_o − c_k|`` per channel. Leaves of one colour (a rope's segments, a pair of legs) can
+  then be omitted however near they are, which is what lets the capped tiers keep K: a bound on the
+  weight alone refused regions for colour differences that were zero.
 τ_ref widens the surface band τ by the slack each ancestor can spend (1.25·k for a polynomial node,
 k·(1 + log N) for a group): beyond it a value can no longer reach the surface through its ancestors.
 """
@@ -144,12 +149,20 @@ def _colour_certificate(
     weight_floor: float,
     k_floor: float,
 ) -> Certificate:
-    """Omitted leaves' colour weight: exp(−(lower_j − d_min)/max(k_j, kFloor)) summed, with d_min bounded
-    by the kept leaves' upper bounds and, on the surface, by τ plus the deepest blend."""
+    """Bound of the colour error of omitting leaves (module docstring): the omitted weights
+    exp(−(lower_j − d_min)/max(k_j, kFloor)) summed, with d_min bounded by the kept leaves' upper bounds
+    and, on the surface, by τ plus the deepest blend, times the largest linear-channel difference between
+    an omitted and a kept colour. It holds when that is at most ``weight_floor`` and the omitted weight
+    is below 1 (so the nearest leaf is a kept one)."""
     omitted = [j for j in range(len(slots)) if j not in kept]
     depth = max(info.depth, default=0.0)
     d_min = min(min(float(bounds.upper[i]) for i in kept), band + depth)
     widths = np.maximum(slots[omitted, col.K], k_floor)
     gaps = np.maximum(bounds.lower[omitted] - d_min, 0.0)
     total = float(np.exp(-gaps / widths).sum()) if omitted else 0.0
-    return Certificate("colour-weight", "colour", tuple(omitted), total, weight_floor, total <= weight_floor)
+    colours = slots[:, col.RGB]
+    kept_colours = colours[sorted(kept)]
+    spread = float(np.abs(colours[omitted][:, None, :] - kept_colours[None, :, :]).max()) if omitted else 0.0
+    value = total * spread
+    holds = value <= weight_floor and total < 1.0
+    return Certificate("colour-weight", "colour", tuple(omitted), value, weight_floor, holds)

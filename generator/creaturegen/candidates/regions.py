@@ -142,9 +142,18 @@ def search(rig: CompiledRig, excursion: np.ndarray, tier: Tier, tol: Tolerances)
             raise TierRejectedError(
                 f"tier {tier.name}: region [{_fmt(c_lo)} .. {_fmt(c_hi)}] needs more than K = {cap} "
                 f"leaves: {worst.kind} at {worst.place} does not hold "
-                f"(value {worst.value:.4g}, threshold {worst.threshold:.4g})"
+                f"(value {worst.value:.4g}, threshold {worst.threshold:.4g}); it keeps "
+                f"{_parts(rig, program.leaves)} and cannot omit {_parts(rig, worst.omitted)} "
+                "(their motion brings them within the blend or colour reach of each other there). "
+                "Build this creature at --tier hero, or move these parts apart or shorten the moving one"
             )
     return RegionSearch(programs, outside, inside)
+
+
+def _parts(rig: CompiledRig, slots: tuple[int, ...]) -> str:
+    """``part.<id>`` of each slot, once per part, in slot order."""
+    names = dict.fromkeys(f"part.{rig.slot_parts[s]}" for s in sorted(slots))
+    return ", ".join(names) or "nothing"
 
 
 def _fmt(v: np.ndarray) -> str:

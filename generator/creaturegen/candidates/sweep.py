@@ -6,7 +6,7 @@ hop, flap and swim cycles, modulo rigid body motion), and random poses that tran
 random vector inside its excursion ball (the envelope the certificates assume).
 Sample points start uniform in each region and take two Newton steps toward the full field's zero set;
 points that leave their region or the band τ are dropped. Measured per point: |Δd|, the angle between
-the normals, the omitted leaves' share of the colour weight, and the OKLab distance of the colours.
+the normals, the largest linear-channel colour error, and the OKLab distance of the colours.
 All regions are sampled together and each distinct program is evaluated once over all its regions.
 """
 
@@ -18,8 +18,6 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..field import layout as col
-from ..field.colour import proximity_weights
-from ..field.primitives import primitive_field
 from ..field.sampler import sample_graph
 from ..rig import CompiledRig
 from ..rig.colour import linear_to_oklab
@@ -35,7 +33,7 @@ class SweepResult:
     points: int  # in-band samples evaluated, all poses together
     surface_error: float  # max |d_program − d_full|, m
     normal_angle_deg: float
-    omitted_colour_weight: float  # max share of the colour weight held by omitted leaves
+    omitted_colour_error: float  # max linear-channel colour error of the programs (omitted leaves' effect)
     delta_e_oklab: float
 
 
@@ -87,8 +85,6 @@ def run_sweep(
         full = sample_graph(rig.graph, slots, p, k_floor)
         inside = (p >= lo[region]).all(axis=1) & (p <= hi[region]).all(axis=1)
         keep = inside & (np.abs(full.distance) <= band)
-        d_slots, _ = primitive_field(slots, p)
-        weights = proximity_weights(d_slots, slots[:, col.K], k_floor)
         for (leaves, graph), members in groups.items():
             idx = np.flatnonzero(keep & np.isin(region, members))
             if len(idx) == 0:
@@ -98,9 +94,7 @@ def run_sweep(
             n_full = full.gradient[idx] / np.linalg.norm(full.gradient[idx], axis=1, keepdims=True)
             n_mine = mine.gradient / np.linalg.norm(mine.gradient, axis=1, keepdims=True)
             angle = np.degrees(np.arccos(np.clip((n_full * n_mine).sum(axis=1), -1.0, 1.0)))
-            w = weights[:, idx]
-            omitted = np.setdiff1d(np.arange(len(slots)), leaves)
-            share = w[omitted].sum(axis=0) / w.sum(axis=0)
+            share = np.abs(full.color[idx] - mine.color).max(axis=1)
             delta_e = np.linalg.norm(linear_to_oklab(full.color[idx]) - linear_to_oklab(mine.color), axis=1)
             error = np.abs(mine.distance - full.distance[idx])
             worst = np.maximum(worst, [error.max(), angle.max(), share.max(), delta_e.max()])

@@ -78,6 +78,8 @@ SWEEP_POSES: Final = 8
 SLOT_MARGIN: Final = 1.25
 JOINT_SLACK_DEG: Final = 10.0
 STILL_DEG: Final = 1e-3
+#: A still joint's pivot stays this close to its rest place relative to the parent, × L (float noise).
+STILL_DRIFT: Final = 1e-9
 #: Headings a run starts at on a support that is not the same in every direction.
 HEADINGS: Final = 4
 
@@ -104,6 +106,17 @@ class PoseEnvelope:
 
     def joint(self, child: int) -> JointEnvelope | None:
         return next((j for j in self.joints if j.child == child), None)
+
+    def still_joints(self, length_scale: float) -> frozenset[int]:
+        """Child slots of the joints the motion never turns: no bend or twist past STILL_DEG and a pivot
+        that stays within STILL_DRIFT·L of its parent, so child and parent share one transform."""
+        return frozenset(
+            j.child
+            for j in self.joints
+            if j.bend_deg <= STILL_DEG
+            and j.twist_deg <= STILL_DEG
+            and j.pivot_drift <= STILL_DRIFT * length_scale
+        )
 
     def sweep_limits(self, child: int) -> tuple[float, float]:
         """(bend, twist) in degrees the skinning sweep of the joint above ``child`` must reach."""

@@ -13,7 +13,7 @@ from typing import Any, Final
 
 from ..field import layout as col
 from ..rig import CompiledRig
-from ..spec import CharacterSpec
+from ..spec import CharacterSpec, character
 from ..surface.skeleton import Skeleton
 from . import quat as vq
 
@@ -47,7 +47,8 @@ ROPE_DAMPING: Final = 0.02
 #: as a minimum distance 2·segment·cos(limit/2) between a node's neighbours.
 ROPE_BEND_LIMIT_DEG: Final = 60.0
 
-WALKERS: Final = ("biped", "quadruped", "hexapod")
+#: The walking locomotion types (spec/character.py, where validation reads them too).
+WALKERS: Final = character.WALKERS
 #: locomotion type -> its gait genes, each the motion-data fields one gene scales together
 #: (creature/genome.py express_gait): pace scales speed with step or hop length, so timing in ticks holds.
 GAIT_GENES: Final[dict[str, tuple[tuple[str, ...], ...]]] = {

@@ -66,6 +66,9 @@ class Gates:
     clamped_ticks: int = 0
     planted_samples: int = 0
     both_swing_ticks: int = 0
+    # Fewest feet planted on any tick (the number of legs until a foot lifts): one phase group swings at a
+    # time, so a walker keeps at least its other groups' feet down (4 of 8 for alternating tetrapods).
+    fewest_planted: int = 0
     steps: int = 0
     rope_anchor: float = 0.0  # |posed anchor of segment 0 − body anchor| / L
     swim_tracking: float = 0.0  # max |y − target| after 2 s, metres
@@ -129,7 +132,7 @@ class Motion:
         self.prev_nodes: list[list[Vec]] = []
         self.swim_y = 0.0
         self.swim_vy = 0.0
-        self.gates = Gates()
+        self.gates = Gates(fewest_planted=len(self.data["legs"]))
         self.quats: list[list[float]] = [list(vq.IDENTITY) for _ in range(self.slot_count)]
         self.trans: list[Vec] = [[0.0, 0.0, 0.0] for _ in range(self.slot_count)]
         self.root: list[float] = [0.0, 0.0, 0.0, 1.0, 0.0, 1.0]  # position, cos yaw, sin yaw, squash
@@ -389,6 +392,7 @@ class Motion:
                 gates.planted_samples += 1
         if len(self.feet) == 2 and swinging == 2:
             gates.both_swing_ticks += 1
+        gates.fewest_planted = min(gates.fewest_planted, len(self.feet) - swinging)
 
     # --- ropes -----------------------------------------------------------------------------------
 

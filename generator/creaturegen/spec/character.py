@@ -13,8 +13,8 @@ from typing import Annotated, Any, Literal
 
 from pydantic import ConfigDict, Field, StrictInt
 
+from .colors import Color
 from .types import (
-    Color,
     Ident,
     Name,
     NonNegative,
@@ -26,7 +26,9 @@ from .types import (
 )
 
 Shape = Literal["capsule", "sphere", "cone", "rope", "leg"]
-LocomotionType = Literal["none", "biped", "quadruped", "hexapod", "hopper", "flyer", "swimmer"]
+LocomotionType = Literal[
+    "none", "biped", "quadruped", "hexapod", "octopod", "walker", "hopper", "flyer", "swimmer"
+]
 
 #: Fields every part may carry, whatever its shape.
 COMMON_PART_FIELDS = ("id", "shape", "parent", "color", "k", "kCap")
@@ -49,13 +51,32 @@ LOCOMOTION_FIELDS: dict[str, tuple[str, ...]] = {
     "biped": ("speed", "stepLength", "stepHeight"),
     "quadruped": ("speed", "stepLength", "stepHeight"),
     "hexapod": ("speed", "stepLength", "stepHeight"),
+    "octopod": ("speed", "stepLength", "stepHeight"),
+    "walker": ("speed", "stepLength", "stepHeight"),
     "hopper": ("speed", "hopLength", "hopHeight"),
     "flyer": ("speed", "altitude", "radius"),
     "swimmer": ("speed", "undulation", "buoyancy"),
 }
 
-#: locomotion type -> number of leg parts it drives; types not listed accept any count.
-LEG_COUNTS: dict[str, int] = {"biped": 2, "quadruped": 4, "hexapod": 6, "hopper": 0, "swimmer": 0}
+#: locomotion type -> number of leg parts it drives; types not listed here nor in WALKER_LEG_COUNTS accept
+#: any count.
+LEG_COUNTS: dict[str, int] = {
+    "biped": 2,
+    "quadruped": 4,
+    "hexapod": 6,
+    "octopod": 8,
+    "hopper": 0,
+    "swimmer": 0,
+}
+
+#: Types whose legs walk: one gait (motion/simulate.py) plants and lifts their feet by phase group, so they
+#: differ only in the leg count they require. The motion reference, the envelope and the JS core read this
+#: tuple (the JS core a copy of it, pinned by the motion parity test).
+WALKERS: tuple[str, ...] = ("biped", "quadruped", "hexapod", "octopod", "walker")
+
+#: Leg counts of the generic ``walker``: left/right pairs, one to four of them. More legs than eight would
+#: outgrow a pose page's slot budget long before the gait cared.
+WALKER_LEG_COUNTS: tuple[int, ...] = (2, 4, 6, 8)
 
 BLEND_KERNELS = ("log-sum-exp",)
 
@@ -164,7 +185,9 @@ class Part(StrictModel):
     r2: Positive | None = Field(default=None, description="Radius at b (tapered capsule, cone), m.")
     k: Positive | None = Field(default=None, description="Blend width of this leaf; default 0.6·r.")
     kCap: Positive | None = Field(default=None, description="Upper bound on the effective blend width.")
-    color: Color | None = Field(default=None, description="sRGB #rrggbb albedo.")
+    color: Color | None = Field(
+        default=None, description="sRGB albedo: #rrggbb, #rgb or a CSS colour name (normalised to #rrggbb)."
+    )
     segments: Annotated[StrictInt, Field(ge=1, le=64)] | None = Field(default=None, description="Rope slots.")
     length: Positive | None = Field(default=None, description="Rope rest length, m.")
     taper: Annotated[Number, Field(gt=0, le=1)] | None = Field(

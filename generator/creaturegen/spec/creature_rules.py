@@ -12,7 +12,14 @@ from collections.abc import Iterator
 from dataclasses import dataclass, field
 from typing import Any
 
-from .character import COMMON_PART_FIELDS, LEG_COUNTS, LOCOMOTION_FIELDS, SHAPE_FIELDS, slots_of
+from .character import (
+    COMMON_PART_FIELDS,
+    LEG_COUNTS,
+    LOCOMOTION_FIELDS,
+    SHAPE_FIELDS,
+    WALKER_LEG_COUNTS,
+    slots_of,
+)
 from .errors import SpecError, shown
 from .messages import did_you_mean, number
 from .places import item_place, usable_ids
@@ -135,14 +142,19 @@ def locomotion(raw: dict[str, Any]) -> list[SpecError]:
         for f in loco
         if f in every and f not in needed
     ]
-    if kind in LEG_COUNTS:
-        legs = sum(1 for _, p in _dicts(raw.get("parts")) if p.get("shape") == "leg")
-        if legs != LEG_COUNTS[kind]:
-            errors.append(
-                SpecError(
-                    "locomotion.type", f"{kind} needs {LEG_COUNTS[kind]} leg parts, the spec has {legs}"
-                )
+    legs = sum(1 for _, p in _dicts(raw.get("parts")) if p.get("shape") == "leg")
+    if kind in LEG_COUNTS and legs != LEG_COUNTS[kind]:
+        errors.append(
+            SpecError("locomotion.type", f"{kind} needs {LEG_COUNTS[kind]} leg parts, the spec has {legs}")
+        )
+    if kind == "walker" and legs not in WALKER_LEG_COUNTS:
+        low, high = WALKER_LEG_COUNTS[0], WALKER_LEG_COUNTS[-1]
+        errors.append(
+            SpecError(
+                "locomotion.type",
+                f"walker needs an even number of leg parts from {low} to {high}, the spec has {legs}",
             )
+        )
     return errors
 
 

@@ -11,8 +11,9 @@ from typing import Annotated, Literal
 
 from pydantic import Field, StrictBool, StrictInt, ValidationInfo, field_validator
 
+from .colors import Color
 from .messages import number
-from .types import Color, Name, NonNegative, Number, Positive, Seed, StrictModel, UnitInterval, rule_error
+from .types import Name, NonNegative, Number, Positive, Seed, StrictModel, UnitInterval, rule_error
 
 TierName = Literal["full", "balanced", "budgeted"]
 

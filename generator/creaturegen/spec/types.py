@@ -13,13 +13,11 @@ from pydantic import AfterValidator, BaseModel, ConfigDict, Field, StrictFloat, 
 from pydantic_core import PydanticCustomError
 
 ID_PATTERN = r"^[A-Za-z][A-Za-z0-9_-]{0,63}$"
-COLOR_PATTERN = r"^#[0-9a-fA-F]{6}$"
 NAME_MAX_LENGTH = 80
 
 #: What a regex means, for messages; pydantic only knows the pattern.
 PATTERN_MEANINGS: dict[str, str] = {
     ID_PATTERN: "an id: a letter, then up to 63 letters, digits, '-' or '_'",
-    COLOR_PATTERN: "a #rrggbb colour",
 }
 
 Number = StrictFloat
@@ -27,7 +25,6 @@ Positive = Annotated[StrictFloat, Field(gt=0)]
 NonNegative = Annotated[StrictFloat, Field(ge=0)]
 UnitInterval = Annotated[StrictFloat, Field(ge=0, le=1)]
 Vec3 = Annotated[list[StrictFloat], Field(min_length=3, max_length=3)]
-Color = Annotated[str, Field(pattern=COLOR_PATTERN)]
 Ident = Annotated[str, Field(pattern=ID_PATTERN)]
 Seed = Annotated[StrictInt, Field(ge=0, le=2**32 - 1)]
 

@@ -39,7 +39,7 @@ from .correct import CorrectionReport, correct, trust_radius
 from .extract import Extraction, extract
 from .field64 import BodyField
 from .gates import DISTANCE_TOL, Direction, SurfaceGate, mesh_gates
-from .grid import Grid, make_grid
+from .grid import Grid, GridTooFineError, make_grid
 from .handles import handle_contacts
 from .mesh import Mesh
 from .sampling import sample_band
@@ -66,8 +66,14 @@ FACE_NORMAL_MAX_DEG = 60.0
 #: Vertices within this many lattice cells of a hard-min crease between two blend roots are left out of
 #: the normal gates: the analytic normal itself jumps there, so no mesh normal can agree with it.
 CREASE_BAND_CELLS = 2.0
-#: Finer lattices tried (each √2 finer) when a mesh gate fails before the build gives up.
+#: Finer lattices tried (each √2 finer) when a mesh gate fails before the build gives up ...
 MAX_REFINEMENTS = 2
+#: ... and further ones, up to EXTRA_REFINEMENTS more, while the lattice stays under SMALL_LATTICE_NODES
+#: nodes: a small body with a narrow fillet (eyes sunk into a small head) needs a few more halvings than a
+#: big one and they cost little (the refuses this turned into builds on the generated corpus were all
+#: below 0.2 M nodes; a hero octopod's first lattice is 6 M).
+EXTRA_REFINEMENTS = 3
+SMALL_LATTICE_NODES = 2_000_000
 #: Calibration points for picking the faster sampling backend.
 CALIBRATION_POINTS = 32768
 #: Candidate index written for a vertex no candidate region covers (it is never corrected).
@@ -345,44 +351,96 @@ class ValidatedMesh:
     timings: dict[str, float]
 
 
+def _may_refine(refinement: int, grid: Grid) -> bool:
+    """Whether the lattice after ``grid`` (refinement + 1) is within the refinement budget."""
+    if refinement < MAX_REFINEMENTS:
+        return True
+    nodes = 2.0**1.5 * float(np.prod(grid.shape))  # √2 finer along each axis
+    return refinement < MAX_REFINEMENTS + EXTRA_REFINEMENTS and nodes <= SMALL_LATTICE_NODES
+
+
+def _failed_count(attempt: ValidatedMesh) -> int:
+    return sum(not g.passed for g in attempt.gates)
+
+
 def validated_mesh(
     rig: CompiledRig, skeleton: Skeleton, tier: str, chosen: FieldBackend, why: str, progress: Progress
 ) -> ValidatedMesh:
-    """Sample, extract and gate; retry √2 finer (up to MAX_REFINEMENTS) while a mesh gate fails."""
-    timings: dict[str, float] = {"sampling": 0.0, "extraction": 0.0, "validation": 0.0}
-    rest_field = BodyField(rig.graph, rig.slots)
-    for refinement in range(MAX_REFINEMENTS + 1):
-        grid = make_grid(rig.slots, rig.graph, tier, rig.slot_parts, refinement)
-        progress(
-            f"lattice {grid.shape} at h = {grid.spacing:.4g} m ({tier}, refinement {refinement}); "
-            f"narrow-band sampling with {chosen.name}"
-        )
-        t = time.perf_counter()
-        band = sample_band(grid, chosen, rig.graph, rig.slots, rig.body_scale)
-        timings["sampling"] += time.perf_counter() - t
-        progress(
-            f"sampled {band.fine_samples:,} fine + {band.coarse_samples:,} coarse nodes "
-            f"({band.fine_samples / band.dense_samples:.1%} of a dense pass)"
-        )
-        t = time.perf_counter()
-        ex = extract(rest_field, band, rig.body_scale)
-        mesh = ex.mesh
-        timings["extraction"] += time.perf_counter() - t
-        progress(f"extracted {mesh.vertex_count:,} vertices, {mesh.face_count:,} triangles")
-        t = time.perf_counter()
-        gates, policy = surface_mesh_gates(rig, ex, rest_field, skeleton, grid.spacing)
-        timings["validation"] += time.perf_counter() - t
-        failed = [g.name for g in gates if not g.passed]
-        progress(
-            f"mesh gates: {len(gates) - len(failed)}/{len(gates)} passed"
-            + (f"; failed {failed}" if failed else "")
-        )
-        if not failed or refinement == MAX_REFINEMENTS:
+    """Sample, extract and gate; retry √2 finer while a mesh gate fails and the refinement budget lasts
+    (``_may_refine``). The result is the first lattice that passes or, when none does, the one that
+    failed the fewest gates: refining can make a mesh worse (two parts closer than a finer lattice
+    resolves open a handle the coarser one had closed), and the user should hear about the best."""
+    best: ValidatedMesh | None = None
+    attempts: list[ValidatedMesh] = []
+    refinement = 0
+    while True:
+        try:
+            attempt = _one_lattice(rig, skeleton, tier, chosen, why, progress, refinement)
+        except GridTooFineError as exc:
+            if best is None:
+                raise
+            progress(f"no finer lattice: {exc}")
             break
-        if failed == ["euler"] and policy.handles_certain:
+        attempts.append(attempt)
+        if best is None or _failed_count(attempt) < _failed_count(best):
+            best = attempt
+        failed = [g.name for g in attempt.gates if not g.passed]
+        if not failed:
+            break
+        if failed == ["euler"] and attempt.policy.handles_certain:
             progress("the field itself closes these handles: a finer lattice cannot open them")
             break
+        if not _may_refine(refinement, attempt.grid):
+            break
         progress("refining the lattice by √2 and extracting again")
+        refinement += 1
+    spent = {key: sum(a.timings[key] for a in attempts) for key in best.timings}
+    best = replace(best, timings=spent)
+    if best.refinement != attempt.refinement:
+        progress(
+            f"keeping refinement {best.refinement} ({_failed_count(best)} failed gates) over the finer "
+            f"refinement {attempt.refinement} ({_failed_count(attempt)} failed)"
+        )
+    return best
+
+
+def _one_lattice(
+    rig: CompiledRig,
+    skeleton: Skeleton,
+    tier: str,
+    chosen: FieldBackend,
+    why: str,
+    progress: Progress,
+    refinement: int,
+) -> ValidatedMesh:
+    """One lattice: sample, extract and gate."""
+    timings: dict[str, float] = {"sampling": 0.0, "extraction": 0.0, "validation": 0.0}
+    rest_field = BodyField(rig.graph, rig.slots)
+    grid = make_grid(rig.slots, rig.graph, tier, rig.slot_parts, refinement)
+    progress(
+        f"lattice {grid.shape} at h = {grid.spacing:.4g} m ({tier}, refinement {refinement}); "
+        f"narrow-band sampling with {chosen.name}"
+    )
+    t = time.perf_counter()
+    band = sample_band(grid, chosen, rig.graph, rig.slots, rig.body_scale)
+    timings["sampling"] += time.perf_counter() - t
+    progress(
+        f"sampled {band.fine_samples:,} fine + {band.coarse_samples:,} coarse nodes "
+        f"({band.fine_samples / band.dense_samples:.1%} of a dense pass)"
+    )
+    t = time.perf_counter()
+    ex = extract(rest_field, band, rig.body_scale)
+    mesh = ex.mesh
+    timings["extraction"] += time.perf_counter() - t
+    progress(f"extracted {mesh.vertex_count:,} vertices, {mesh.face_count:,} triangles")
+    t = time.perf_counter()
+    gates, policy = surface_mesh_gates(rig, ex, rest_field, skeleton, grid.spacing)
+    timings["validation"] += time.perf_counter() - t
+    failed = [g.name for g in gates if not g.passed]
+    progress(
+        f"mesh gates: {len(gates) - len(failed)}/{len(gates)} passed"
+        + (f"; failed {failed}" if failed else "")
+    )
     sampling = SamplingReport(
         chosen.name,
         why,
@@ -460,7 +518,15 @@ def _extract_surface(
         _fail_on(gates, f"surface {tier}")
 
     t = time.perf_counter()
-    weights = skin_weights(mesh, rest_field, skeleton)
+    envelope = pose_envelope(spec, rig)
+    timings["envelope"] = time.perf_counter() - t
+    progress(
+        f"motion envelope: {len(envelope.runs)} runs × {envelope.ticks} ticks "
+        f"({envelope.samples:,} poses measured)"
+    )
+
+    t = time.perf_counter()
+    weights = skin_weights(mesh, rest_field, skeleton, still=envelope.still_joints(rig.body_scale))
     gates += list(weights.gates)
     timings["weights"] = time.perf_counter() - t
     progress(f"skin weights: {weights.barrier_edges} barrier edges, {timings['weights']:.2f} s")
@@ -468,11 +534,6 @@ def _extract_surface(
         _fail_on(list(weights.gates), f"surface {tier} skin weights")
 
     t = time.perf_counter()
-    envelope = pose_envelope(spec, rig)
-    progress(
-        f"motion envelope: {len(envelope.runs)} runs × {envelope.ticks} ticks "
-        f"({envelope.samples:,} poses measured)"
-    )
     choice = deform.choose_deformation(
         mesh,
         weights.indices,

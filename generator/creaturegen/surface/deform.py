@@ -989,6 +989,10 @@ def _joint_sweep(
         surface_p99 = np.percentile(error, 99, axis=2)
 
     labels = [label for label, _ in poses]
+    # The relative gates compare a method with the best method that keeps the joint at that pose: a
+    # collapsed LBS joint hugs the posed body from inside (its vertices pulled towards the pivot), so
+    # measuring DQ's or CoR's surface error and bulge against it charged them for not collapsing.
+    keeps = collapse >= COLLAPSE_MIN
     # The joint's scale: its radius, or the lever from the pivot to the seam where the pivot is buried
     # inside the parent (a hip), since every method's displacement, and so its artefacts, grows with the
     # lever as much as with the radius.
@@ -1004,7 +1008,9 @@ def _joint_sweep(
         common = (
             _gate("surface_max", worst(surface_max / length_scale), SURFACE_MAX_FACTOR * r_l, "L"),
             _gate("surface_p99", worst(surface_p99 / length_scale), SURFACE_P99_FACTOR * r_l, "L"),
-            _gate("surface_excess", worst(_excess(surface_max) / length_scale), EXCESS_FACTOR * r_l, "L"),
+            _gate(
+                "surface_excess", worst(_excess(surface_max, keeps) / length_scale), EXCESS_FACTOR * r_l, "L"
+            ),
             _gate("joint_collapse", worst(collapse, low=True), COLLAPSE_MIN, "ratio", "min"),
         )
         # The seed's split: LBS stands or falls by its twist (collapse) and volume sweep; DQ and CoR,
@@ -1017,7 +1023,7 @@ def _joint_sweep(
                 "V_rest",
             )
             if method == "lbs"
-            else _gate("bulge_excess", worst(_excess(bulge) / length_scale), EXCESS_FACTOR * r_l, "L")
+            else _gate("bulge_excess", worst(_excess(bulge, keeps) / length_scale), EXCESS_FACTOR * r_l, "L")
         )
         measurements = tuple(
             Measurement(name, *worst(values), unit)
@@ -1041,9 +1047,14 @@ def _worst(column: F64, labels: Sequence[str], low: bool = False) -> tuple[float
     return float(column[p]), labels[p]
 
 
-def _excess(values: F64) -> F64:
-    """(P, 3) per pose, each method's value above the best (smallest) of the three."""
-    result: F64 = values - values.min(axis=1, keepdims=True)
+def _excess(values: F64, keeps: Bools | None = None) -> F64:
+    """(P, 3) per pose, each method's value above the best (smallest) of the methods that keep the joint
+    at that pose (``keeps``: joint_collapse passes), or of all three where none does."""
+    if keeps is None:
+        keeps = np.ones(values.shape, dtype=bool)
+    usable = np.where(keeps.any(axis=1, keepdims=True), keeps, True)
+    best = np.where(usable, values, np.inf).min(axis=1, keepdims=True)
+    result: F64 = np.maximum(values - best, 0.0)
     return result
 
 

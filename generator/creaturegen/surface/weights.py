@@ -60,9 +60,15 @@ Gates (each measured against a stated threshold):
 - ``weights.influences``: most non-zero influences on a vertex ≤ ``max_influences``;
 - ``weights.barrier_leakage``: max weight a slot holds on a vertex owned by a slot that is not its
   skeleton neighbour, ≤ ``LEAKAGE_MAX`` (0.01);
-- ``weights.continuity``: max over mesh edges of max_s |Δw_s|, ≤ ``CONTINUITY_MAX``, on edges outside
-  the contact zones. Unitless on purpose: a hard seam (handles of two slots side by side, a cut where
-  none was meant) reads ≈ 1 whatever the mesh density, a transition spread over n edge rings ≈ 1/n.
+- ``weights.continuity``: max over mesh edges of max_g |ΔW_g|, ≤ ``CONTINUITY_MAX``, on edges outside
+  the contact zones, where W_g sums the weights of the slots of one *motion group*: slots joined by
+  joints the creature's motion never turns (an eye on a head, a horn, a fin the gait does not move;
+  the build passes them from the measured motion envelope). Every slot of a group gets the same
+  transform in every pose, so every skinning method maps a vertex to the same place however its weight
+  is split inside the group: a jump there cannot be seen, and a gate on it refused creatures for
+  nothing (eyes on heads, measured on the generated corpus). Between groups the gate is unchanged.
+  Unitless on purpose: a hard seam (handles of two slots side by side, a cut where none was meant)
+  reads ≈ 1 whatever the mesh density, a transition spread over n edge rings ≈ 1/n.
   A contact zone is where two slots that are not skeleton neighbours are both within a handle gap of
   the surface: there the barrier makes weights jump by design (the contact is meant to open when the
   limbs move), and a junction squeezed between them may be one or two edges wide. The detail reports
@@ -306,13 +312,31 @@ def _prune(dense: F64, max_influences: int) -> tuple[I32, F64]:
     return indices, weights
 
 
+def motion_groups(skeleton: Skeleton, still: frozenset[int]) -> I32:
+    """(S,) group per slot: slots joined through joints whose child is in ``still`` (joints the motion
+    never turns) share a group, so they share one transform in every pose."""
+    group = np.arange(len(skeleton.parent), dtype=np.int32)
+    for slot in skeleton.order:  # parents first: a still child takes its parent's final group
+        parent = skeleton.parent[slot]
+        if parent >= 0 and slot in still:
+            group[slot] = group[parent]
+    return group
+
+
 def skin_weights(
-    mesh: Mesh, field: BodyField, skeleton: Skeleton, *, max_influences: int = 4, barrier: bool = True
+    mesh: Mesh,
+    field: BodyField,
+    skeleton: Skeleton,
+    *,
+    max_influences: int = 4,
+    barrier: bool = True,
+    still: frozenset[int] = frozenset(),
 ) -> SkinWeights:
     """Harmonic skin weights with contact barriers and gates; the module docstring says why.
 
     ``barrier=False`` drops both barrier measures (edge cut and neighbour supports), which is only
-    useful to show that the leakage gate catches what the barrier prevents.
+    useful to show that the leakage gate catches what the barrier prevents. ``still`` holds the child
+    slots of joints the motion never turns (the continuity gate reads their groups' summed weights).
     """
     if max_influences < 1:
         raise ValueError("max_influences must be at least 1")
@@ -343,7 +367,17 @@ def skin_weights(
     contact = np.einsum("sv,st,tv->v", closeness, (~near).astype(np.float64), closeness) > 0.0
     kept = np.asarray(cot[edges[:, 0], edges[:, 1]]).ravel() > 0.0
     gates = _gates(
-        edges[kept], contact, indices, weights, owner, handle, near, skeleton, relaxed, int(stranded.sum())
+        edges[kept],
+        contact,
+        indices,
+        weights,
+        owner,
+        handle,
+        near,
+        skeleton,
+        relaxed,
+        int(stranded.sum()),
+        motion_groups(skeleton, still),
     )
     return SkinWeights(indices, weights, owner, handle, contact, barrier_edges, gates)
 
@@ -359,6 +393,7 @@ def _gates(
     skeleton: Skeleton,
     relaxed: list[int],
     stranded: int,
+    groups: I32,
 ) -> tuple[SurfaceGate, ...]:
     s_count = near.shape[0]
     v_count = indices.shape[0]
@@ -368,9 +403,15 @@ def _gates(
     worst = int(np.argmax(leak)) if v_count else 0
     dense = np.zeros((v_count, s_count))
     np.add.at(dense, (np.arange(v_count)[:, None], indices), weights)
-    jump = np.abs(dense[edges[:, 0]] - dense[edges[:, 1]]).max(axis=1, initial=0.0)
+    membership = np.zeros((s_count, int(groups.max(initial=0)) + 1))
+    membership[np.arange(s_count), groups] = 1.0
+    grouped = dense @ membership
+    jump = np.abs(grouped[edges[:, 0]] - grouped[edges[:, 1]]).max(axis=1, initial=0.0)
+    slot_jump = np.abs(dense[edges[:, 0]] - dense[edges[:, 1]]).max(axis=1, initial=0.0)
     outside = ~contact[edges[:, 0]] & ~contact[edges[:, 1]]
     smooth = jump[outside] if outside.any() else np.zeros(1)
+    worst_edge = int(np.flatnonzero(outside)[np.argmax(smooth)]) if outside.any() else 0
+    merged = len(groups) - len(np.unique(groups))
     present = np.bincount(owner, minlength=s_count) > 0
     pinned = np.bincount(handle[handle >= 0], minlength=s_count) > 0
     missing = [skeleton.names[s] for s in np.flatnonzero(present & ~pinned)]
@@ -400,7 +441,10 @@ def _gates(
                 f"outside contact zones: p99 {float(np.quantile(smooth, 0.99)):.3g} "
                 f"over {int(outside.sum())} edges; "
                 f"all kept edges {float(jump.max(initial=0.0)):.3g}; "
-                f"{int(contact.sum())} contact-zone vertices"
+                f"{int(contact.sum())} contact-zone vertices; "
+                f"per slot {float(slot_jump[outside].max(initial=0.0)):.3g} ({merged} slots share a "
+                f"motion group with their parent); worst edge between "
+                f"{_edge_slots(edges[worst_edge], dense, skeleton)}"
             ),
         ),
         SurfaceGate(
@@ -411,3 +455,10 @@ def _gates(
             detail="; ".join(x for x in coverage if x),
         ),
     )
+
+
+def _edge_slots(edge: I64, dense: F64, skeleton: Skeleton) -> str:
+    """The two slots whose weights change most along ``edge``, by name (the parts a seam lies between)."""
+    change = dense[edge[0]] - dense[edge[1]]
+    gain, loss = int(np.argmax(change)), int(np.argmin(change))
+    return f"{skeleton.names[gain]} and {skeleton.names[loss]}"

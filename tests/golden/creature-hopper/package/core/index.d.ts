@@ -79,7 +79,10 @@ export interface Driver {
 
 export interface MotionGates {
   plantDrift: number; ikResidual: number; drawnFoot: number; clampedTicks: number; plantedSamples: number;
-  bothSwingTicks: number; steps: number; ropeAnchor: number; swimTracking: number; apexError: number;
+  bothSwingTicks: number;
+  /** Fewest feet planted on any tick since reset (the leg count until a foot lifts). */
+  fewestPlanted: number;
+  steps: number; ropeAnchor: number; swimTracking: number; apexError: number;
   apexSquash: number; squashDet: number;
 }
 

@@ -19,9 +19,10 @@ import { SWIMMER_CHANNELS, createFlatGround, createGravity, toLocal, toWorld } f
 import { derive } from './derived.js';
 import { sincos } from './trig.js';
 
-const WALKERS = ['biped', 'quadruped', 'hexapod'];
-const GATE_NAMES = ['plantDrift', 'ikResidual', 'drawnFoot', 'clampedTicks', 'plantedSamples', 'bothSwingTicks', 'steps',
-  'ropeAnchor', 'swimTracking', 'apexError', 'apexSquash', 'squashDet'];
+// The walking locomotion types (creaturegen spec/character.py WALKERS): one gait, any even leg count 2..8.
+const WALKERS = ['biped', 'quadruped', 'hexapod', 'octopod', 'walker'];
+const GATE_NAMES = ['plantDrift', 'ikResidual', 'drawnFoot', 'clampedTicks', 'plantedSamples', 'bothSwingTicks',
+  'fewestPlanted', 'steps', 'ropeAnchor', 'swimTracking', 'apexError', 'apexSquash', 'squashDet'];
 const G = Object.freeze(Object.fromEntries(GATE_NAMES.map((name, i) => [name, i])));
 
 export class TierRefusedError extends Error {}
@@ -116,6 +117,7 @@ export function createMotion(data, lcg, { support = createFlatGround(), gravity 
   function resetGates() {
     gv.fill(0);
     gv[G.apexSquash] = 1;
+    gv[G.fewestPlanted] = L;
   }
 
   /** The gates as a plain object (allocates; the per-tick path writes the typed array only). */
@@ -462,6 +464,7 @@ export function createMotion(data, lcg, { support = createFlatGround(), gravity 
       }
     }
     if (L === 2 && swinging === 2) gv[G.bothSwingTicks] += 1;
+    gv[G.fewestPlanted] = Math.min(gv[G.fewestPlanted], L - swinging);
   }
 
   // --- ropes -------------------------------------------------------------------------------------------

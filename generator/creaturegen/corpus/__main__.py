@@ -1,0 +1,7 @@
+"""``python -m creaturegen.corpus``: see corpus/run.py."""
+
+import sys
+
+from .run import main
+
+sys.exit(main())
