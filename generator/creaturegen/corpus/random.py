@@ -370,11 +370,12 @@ def _biped(c: _Creature) -> None:
     a, b = [0.0, hip_y + radius * 0.5, 0.0], [0.0, hip_y + radius * 0.5 + torso, rng.uniform(-0.02, 0.06)]
     body = c.capsule("body", None, a, b, radius, radius * rng.uniform(0.8, 1.15), colour=0)
     leg_r = min(radius * rng.uniform(0.25, 0.5), 0.3 * min(upper, lower))
+    hip_x = max(radius * 0.55, leg_r * rng.uniform(1.5, 2.0))  # thighs clear of each other, as walkers' are
     for side, sign, phase in (("left", 1.0, 0.0), ("right", -1.0, 0.5)):
         c.leg(
             f"leg-{side}",
             body,
-            [sign * radius * 0.55, hip_y, rng.uniform(0.0, 0.1)],
+            [sign * hip_x, hip_y, rng.uniform(0.0, 0.1)],
             upper,
             lower,
             leg_r,

@@ -39,7 +39,7 @@ from .correct import CorrectionReport, correct, trust_radius
 from .extract import Extraction, extract
 from .field64 import BodyField
 from .gates import DISTANCE_TOL, Direction, SurfaceGate, mesh_gates
-from .grid import Grid, GridTooFineError, make_grid
+from .grid import FIRST_CELLS_LIMIT, Grid, GridTooFineError, make_grid
 from .handles import handle_contacts
 from .mesh import Mesh
 from .sampling import sample_band
@@ -417,6 +417,11 @@ def _one_lattice(
     timings: dict[str, float] = {"sampling": 0.0, "extraction": 0.0, "validation": 0.0}
     rest_field = BodyField(rig.graph, rig.slots)
     grid = make_grid(rig.slots, rig.graph, tier, rig.slot_parts, refinement)
+    if grid.limited_by:
+        progress(
+            f"{grid.limited_by} is too thin for the {tier} sagitta target within "
+            f"{FIRST_CELLS_LIMIT} cells; sampling there first, the mesh gates judge it"
+        )
     progress(
         f"lattice {grid.shape} at h = {grid.spacing:.4g} m ({tier}, refinement {refinement}); "
         f"narrow-band sampling with {chosen.name}"
@@ -641,6 +646,7 @@ def _extract_surface(
             "spacing": grid.spacing,
             "origin": list(grid.origin),
             "refinement": refinement,
+            "limitedBy": grid.limited_by,
         },
         "sampling": sampling.as_dict(),
         "extraction": {"residual": ex.residual, "relaxReverted": ex.relax_reverted},

@@ -4,9 +4,12 @@ Spacing rule. A marching-cubes surface whose vertices lie on the zero set deviat
 triangle by at most the chord sagitta ``h²κ/8`` for edge length ``h`` and curvature ``κ``. The sharpest
 convex curvature a body of round primitives has is ``1/r_min`` (its thinnest primitive end), so a target
 sagitta of ``ε·r_min`` gives ``h = √(8ε)·r_min``. Concave blend fillets are flatter than that (their
-radius grows with the blend width k), so the same bound covers them. The grid extent is capped: a body
-whose thinnest part would need more cells than ``MAX_CELLS_PER_AXIS`` fails the build naming that part
-rather than silently missing its error target.
+radius grows with the blend width k), so the same bound covers them. The grid extent is capped: when the
+thinnest part (a horn's or a claw's pointed tip) would need more cells than ``FIRST_CELLS_LIMIT``, the
+first lattice has that many along its longest axis and says so (``Grid.limited_by``). The sagitta target
+is how the spacing is chosen, not what protects the mesh: the mesh gates (distance to the zero set, normals,
+topology, in units of the body size L) judge the result, and a pointed tip a little blunter than its own
+radius asks for passes them or fails them by name; refinements follow while they fit the cap.
 """
 
 from __future__ import annotations
@@ -25,6 +28,10 @@ from ..rig.graph import BlendGraph
 ERROR_TARGET = {"hero": 0.06, "repeated": 0.125, "distant": 0.25}
 #: Largest lattice extent along any axis; beyond it the target is unreachable at load-time cost.
 MAX_CELLS_PER_AXIS = 640
+#: Largest first lattice: a body whose sagitta target asks for more starts here, and refinements (each √2
+#: finer) go on up to MAX_CELLS_PER_AXIS. A 640-cell first lattice on a 30 cm biped with 5 mm horn tips
+#: made 307 k vertices and took minutes; the mesh gates decide whether the coarser one will do.
+FIRST_CELLS_LIMIT = 448
 #: Fine cells per narrow-band block edge.
 BLOCK = 8
 #: Upper bound on |∇d| for every primitive form and blend (see ``LIPSCHITZ_BOUND``) with margin.
@@ -42,6 +49,7 @@ class Grid:
     origin: tuple[float, float, float]
     spacing: float
     shape: tuple[int, int, int]  # nodes per axis, each a multiple of BLOCK plus one
+    limited_by: str = ""  # the part whose sagitta target the cell cap did not allow, when one did not fit
 
     def points(self, index: npt.NDArray[np.int64] | npt.NDArray[np.float64]) -> npt.NDArray[np.float64]:
         """World positions of integer (or half-integer) lattice coordinates (N, 3)."""
@@ -106,17 +114,28 @@ def make_grid(
     ``refinement`` n divides the spacing by 2^(n/2): the build retries finer when a topology gate fails
     (a gap between parts narrower than the spacing lets marching cubes bridge it).
     """
-    h = spacing_for(slots, tier) / 2.0 ** (refinement / 2.0)
-    lo, hi = body_box(slots, graph)
-    lo = lo - 2.0 * h
+    box_lo, hi = body_box(slots, graph)
+    extent = float((hi - box_lo).max())
+    h = spacing_for(slots, tier)
+    limited_by = ""
+    if extent / h + 4.0 > FIRST_CELLS_LIMIT:
+        _, index = smallest_radius(slots)
+        limited_by = f"part.{slot_names[index]}"
+        h = extent / (FIRST_CELLS_LIMIT - BLOCK)  # room for the two-cell pads, rounded up to a block
+    h /= 2.0 ** (refinement / 2.0)
+    lo = box_lo - 2.0 * h
     cells = np.ceil((hi + 2.0 * h - lo) / h).astype(np.int64)
     cells = ((cells + BLOCK - 1) // BLOCK) * BLOCK
     if int(cells.max()) > MAX_CELLS_PER_AXIS:
         r_min, index = smallest_radius(slots)
+        # The spacing, and with it the cell count, is proportional to the thinnest radius.
+        fits = r_min * float(cells.max()) / MAX_CELLS_PER_AXIS
+        end = "r" if slots[index, col.RA] <= slots[index, col.RB] else "r2"
         raise GridTooFineError(
-            f"part.{slot_names[index]}.r: radius {r_min:.4g} m needs {int(cells.max())} lattice cells "
+            f"part.{slot_names[index]}.{end}: radius {r_min:.4g} m needs {int(cells.max())} lattice cells "
             f"along one axis for the {tier} surface-error target ({ERROR_TARGET[tier]}·r); the limit is "
-            f"{MAX_CELLS_PER_AXIS}. Thicken the part or choose a coarser tier."
+            f"{MAX_CELLS_PER_AXIS}. Thicken part.{slot_names[index]} to a radius of at least {fits:.3g} m "
+            "(r × scale), or choose a coarser tier."
         )
     shape = (int(cells[0]) + 1, int(cells[1]) + 1, int(cells[2]) + 1)
-    return Grid((float(lo[0]), float(lo[1]), float(lo[2])), h, shape)
+    return Grid((float(lo[0]), float(lo[1]), float(lo[2])), h, shape, limited_by)
