@@ -43,8 +43,9 @@ CREATURE_EXAMPLES = [
     "moth.json",
 ]
 #: Creature specs under tests/fixtures/ that the motion tests (gates, envelope, JS core parity, allocation)
-#: run beside the examples, named ``fixtures/<file>``; the browser parity jobs do not build them.
-MOTION_FIXTURES = ["fixtures/spider.json"]
+#: run beside the examples, named ``fixtures/<file>``; the browser parity jobs do not build them. The spider
+#: is an octopod; the kangaroo a hopper on its two hind legs.
+MOTION_FIXTURES = ["fixtures/spider.json", "fixtures/kangaroo.json"]
 
 
 def spec_file(name: str) -> Path:

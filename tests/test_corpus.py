@@ -44,6 +44,10 @@ def test_random_specs_validate_and_cover_what_people_write() -> None:
             if part.shape == "rope":
                 features["rope"] += 1
         features["named colour"] += any(not str(p["color"]).startswith("#") for p in raw["parts"])
+        legs = sum(p.shape == "leg" for p in spec.parts)
+        hopper = spec.locomotion is not None and spec.locomotion.type == "hopper"
+        features["hopper with legs"] += hopper and legs == 2
+        features["8 legs"] += legs == 8
     assert set(kinds) == set(LOCOMOTION_WEIGHTS)
     assert set(blends) == {"default", "tree", "symmetric-nary"}
     assert PART_RANGE[0] <= min(parts)

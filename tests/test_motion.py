@@ -43,8 +43,8 @@ from creaturegen.spec.gate import load_spec, validate_bytes
 from creaturegen.surface.skeleton import build_skeleton
 
 TICKS = 1000
-#: The examples and the motion fixtures (the eight-legged spider): every gate and the JS core parity run on
-#: each.
+#: The examples and the motion fixtures (the eight-legged spider, the kangaroo: a hopper on two legs): every
+#: gate and the JS core parity run on each.
 MOTION_SPECS = [*CREATURE_EXAMPLES, *MOTION_FIXTURES]
 
 
@@ -87,6 +87,10 @@ def assert_gates(where: str, g: Gates, data: dict[str, Any], ticks: int) -> None
         assert g.apex_error <= 1e-9, f"{where}: hop apex height error {g.apex_error:.3g} m"
         assert g.apex_squash == 1.0, f"{where}: squash at the apex tick is {g.apex_squash!r}"
         assert g.squash_det <= 4e-16, f"{where}: squash determinant off by {g.squash_det:.3g}"
+        if data["legs"]:
+            # Its legs take off with every hop and are planted (and drift-gated) between hops.
+            assert g.steps > 0, f"{where}: the legs never left the ground"
+            assert g.planted_samples > 0, f"{where}: no planted foot was measured"
     if kind == "swimmer":
         assert 0.0 < g.swim_tracking < 0.09, f"{where}: swim tracking {g.swim_tracking:.3g} m after 2 s"
 
@@ -365,18 +369,27 @@ def test_js_core_matches_python_for_the_generic_walker_type(creature_out: Path, 
     reference = {**motion_reference(data), "data": data}
     path = tmp_path / "motion-reference.json"
     path.write_text(json.dumps(reference))
-    real = (package / "core" / "index.js").resolve().as_uri()
-    relabelled = tmp_path / "walker-core.mjs"
-    relabelled.write_text(
-        f"import * as real from {json.dumps(real)};\n"
-        f"export * from {json.dumps(real)};\n"
-        "export const CREATURE = { ...real.CREATURE, motion: { ...real.CREATURE.motion, type: 'walker' } };\n"
+    relabelled = wrapped_core(
+        package,
+        tmp_path / "walker-core.mjs",
+        "export const CREATURE = "
+        "{ ...real.CREATURE, motion: { ...real.CREATURE.motion, type: 'walker' } };\n",
     )
     env = {"MOTION_CORE": str(relabelled), "MOTION_REFERENCE": str(path)}
     done = run_node_tests("motion_core.test.mjs", env)
     assert re.search(r"\bpass 6\b", done.stdout), done.stdout
     assert all(case["gates"]["steps"] > 0 for case in reference["cases"]), "the walker never stepped"
     print("walker spider: " + "; ".join(re.findall(r"^\S+ seed \d+: worst .*$", done.stdout, re.M)))
+
+
+def wrapped_core(package: Path, path: Path, override: str) -> Path:
+    """A module at ``path`` that re-exports the package's core (as ``real``) with ``override`` appended:
+    an export of the same name there shadows the star export."""
+    real = (package / "core" / "index.js").resolve().as_uri()
+    path.write_text(
+        f"import * as real from {json.dumps(real)};\nexport * from {json.dumps(real)};\n" + override
+    )
+    return path
 
 
 #: Heap growth allowed over the measured steps: room for the probe's own bookkeeping (a few kB), far below
@@ -444,11 +457,9 @@ def test_the_probe_does_not_depend_on_when_the_compiler_thread_runs(creature_out
 def test_the_probe_catches_a_step_that_allocates(creature_out: Path, tmp_path: Path) -> None:
     """The hexapod's own core with one small array kept per step (dropped every 64): the probe must see it."""
     package = build_example("reference/hexapod.json", creature_out)
-    real = (package / "core" / "index.js").resolve().as_uri()
-    planted = tmp_path / "planted.mjs"
-    planted.write_text(
-        f"import * as real from {json.dumps(real)};\n"
-        f"export * from {json.dumps(real)};\n"
+    planted = wrapped_core(
+        package,
+        tmp_path / "planted.mjs",
         "export function createMotion(...args) {\n"
         "  const motion = real.createMotion(...args);\n"
         "  const step = motion.step.bind(motion);\n"
@@ -459,7 +470,7 @@ def test_the_probe_catches_a_step_that_allocates(creature_out: Path, tmp_path: P
         "    return step();\n"
         "  };\n"
         "  return motion;\n"
-        "}\n"
+        "}\n",
     )
     alloc = allocation_probe(planted)["allocation"]
     print(f"planted hexapod: {alloc['heapGrowthBytes']} B, {alloc['collections']} GCs ({windows(alloc)})")

@@ -337,3 +337,11 @@ def test_relative_gates_compare_with_a_method_that_keeps_the_joint() -> None:
     assert excess[1].tolist() == pytest.approx([0.0, 0.001, 0.002])
     # Where no method keeps the joint, all three stay the reference (the absolute gates fail them).
     assert np.array_equal(deform._excess(values, np.zeros_like(keeps)), deform._excess(values))
+
+
+def test_a_refused_joint_says_how_far_the_motion_turns_it() -> None:
+    error = deform.DeformationError("part.leg-front-right[0]", [], 125.8, 15.9)
+    assert "part.leg-front-right[0]" in str(error)
+    assert "126° bend and 16° twist" in str(error)
+    assert "shorter step" in str(error)
+    assert "turns this joint" not in str(deform.DeformationError("part.x", []))

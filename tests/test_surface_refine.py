@@ -21,3 +21,44 @@ def test_extra_refinements_only_while_the_lattice_is_small() -> None:
     big = _grid(121)  # 1.77 M nodes, 5.0 M after a √2 refinement
     assert SMALL_LATTICE_NODES < 2.0**1.5 * 121**3
     assert not _may_refine(MAX_REFINEMENTS, big)
+
+
+def test_a_pointed_tip_starts_at_the_first_lattice_cap_and_refines_up_to_the_limit() -> None:
+    """A 1 m body with a 0.5 mm tip asks for far more cells than the cap: the first lattice stops at
+    FIRST_CELLS_LIMIT and names the part; refinements follow until MAX_CELLS_PER_AXIS, then stop with a
+    message that names the part and the radius that would fit."""
+    import numpy as np
+    import pytest
+
+    from creaturegen.field import layout as col
+    from creaturegen.rig.graph import BlendGraph
+    from creaturegen.surface.grid import (
+        BLOCK,
+        FIRST_CELLS_LIMIT,
+        MAX_CELLS_PER_AXIS,
+        GridTooFineError,
+        make_grid,
+    )
+
+    slots = np.zeros((2, col.WIDTH))
+    slots[0, col.A], slots[0, col.B], slots[0, col.RA], slots[0, col.RB] = (0, 0, 0), (0, 0, 1), 0.2, 0.2
+    slots[1, col.A], slots[1, col.B], slots[1, col.RA], slots[1, col.RB] = (
+        (0, 0, 1),
+        (0, 0.3, 1.2),
+        0.02,
+        5e-4,
+    )
+    graph = BlendGraph((), ())
+    first = make_grid(slots, graph, "hero", ("body", "horn"))
+    assert first.limited_by == "part.horn"
+    assert max(first.shape) - 1 <= FIRST_CELLS_LIMIT + BLOCK
+    finer = make_grid(slots, graph, "hero", ("body", "horn"), refinement=1)
+    assert max(finer.shape) - 1 <= MAX_CELLS_PER_AXIS
+    assert finer.spacing == pytest.approx(first.spacing / 2**0.5)
+    with pytest.raises(
+        GridTooFineError, match=r"part\.horn\.r2: .*Thicken part\.horn to a radius of at least"
+    ):
+        make_grid(slots, graph, "hero", ("body", "horn"), refinement=2)
+    # A body whose target fits is not limited.
+    slots[1, col.RB] = 0.02
+    assert make_grid(slots, graph, "hero", ("body", "horn")).limited_by == ""

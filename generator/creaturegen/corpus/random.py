@@ -403,9 +403,52 @@ def _biped(c: _Creature) -> None:
         _tail(c, body, [0.0, a[1], -radius * 0.6], radius, torso)
 
 
-def _hopper(c: _Creature) -> None:
-    """A round upright body that hops: a slime, a bunny or a kangaroo-like bean."""
+def _kangaroo(c: _Creature) -> None:
+    """A hopper on two hind legs: a body leaning forward over hips under its rear, a thick rope tail,
+    short arms and a head with long ears."""
     rng = c.rng
+    reach = rng.uniform(0.4, 0.7)
+    upper = reach * rng.uniform(0.42, 0.5)
+    lower = reach - upper
+    radius = rng.uniform(0.14, 0.24)
+    hip_y = reach * rng.uniform(0.8, 0.95)
+    back = [0.0, hip_y + radius * 0.4, -radius * 0.6]
+    front = [0.0, back[1] + rng.uniform(0.2, 0.4), back[2] + rng.uniform(0.25, 0.45)]
+    body = c.capsule("body", None, back, front, radius, radius * rng.uniform(0.65, 0.85), colour=0)
+    leg_r = min(radius * rng.uniform(0.25, 0.35), 0.3 * min(upper, lower))
+    hip_x = max(radius * 0.5, leg_r * rng.uniform(1.5, 2.0))
+    for side, sign in (("left", 1.0), ("right", -1.0)):
+        c.leg(
+            f"leg-{side}",
+            body,
+            [sign * hip_x, hip_y, back[2] + radius * 0.9],
+            upper,
+            lower,
+            leg_r,
+            0.0,
+            colour=2,
+        )
+        shoulder = _add(front, [sign * radius * 0.45, -radius * 0.5, radius * 0.3])
+        c.capsule(
+            f"arm-{side}",
+            body,
+            shoulder,
+            _add(shoulder, [0.0, -radius * 0.7, radius * 0.35]),
+            radius * 0.16,
+            radius * 0.12,
+            colour=1,
+        )
+    head_r = radius * rng.uniform(0.45, 0.6)
+    _head(c, body, _add(front, [0.0, head_r * 1.6, radius * 0.5]), head_r, None, "mammal")
+    _tail(c, body, _add(back, [0.0, -radius * 0.5, -radius * 0.3]), radius * 1.6, reach * 1.4)
+
+
+def _hopper(c: _Creature) -> None:
+    """A round upright body that hops (a slime, a bunny, a bean) or a kangaroo on its two legs."""
+    rng = c.rng
+    if rng.random() < 0.35:
+        _kangaroo(c)
+        return
     radius = rng.uniform(0.18, 0.35)
     height = rng.uniform(0.2, 0.8)
     body = c.capsule(

@@ -14,7 +14,7 @@ from typing import Any
 import numpy as np
 
 from .. import __version__
-from ..candidates import TierRejectedError, build_candidates
+from ..candidates import CandidateSet, TierRejectedError, build_candidates
 from ..field import layout as col
 from ..field.floors import floors_for
 from ..field.primitives import GRADIENT_FLOOR, slot_uses_round_cone
@@ -42,14 +42,20 @@ class CreaturePlan:
     skeleton: Skeleton
 
 
-def program_tapes(spec: CharacterSpec, rig: CompiledRig, tier: str) -> tuple[list[Tape], str]:
-    """Tapes of the tier's candidate programs (the asset's ``_CANDIDATE`` indexes them) + the full graph."""
-    try:
-        found = build_candidates(spec, rig, tier)
-        tapes = [compile_tape(p.graph, p.leaves) for p in found.programs]
-        note = ""
-    except TierRejectedError as exc:
-        tapes, note = [], str(exc)
+def program_tapes(
+    spec: CharacterSpec, rig: CompiledRig, tier: str, found: CandidateSet | str | None = None
+) -> tuple[list[Tape], str]:
+    """Tapes of the tier's candidate programs (the asset's ``_CANDIDATE`` indexes them) + the full graph.
+    ``found`` is the surface build's own result when it computed one (the same call on the same rig)."""
+    if found is None:
+        try:
+            found = build_candidates(spec, rig, tier)
+        except TierRejectedError as exc:
+            found = str(exc)
+    if isinstance(found, str):
+        tapes, note = [], found
+    else:
+        tapes, note = [compile_tape(p.graph, p.leaves) for p in found.programs], ""
     tapes.append(compile_tape(rig.graph))
     return tapes, note
 
@@ -72,7 +78,7 @@ def build_plan(
 ) -> CreaturePlan:
     skeleton = build_skeleton(spec, rig)
     motion = build_motion(spec, rig, skeleton)
-    tapes, note = program_tapes(spec, rig, surface.tier)
+    tapes, note = program_tapes(spec, rig, surface.tier, surface.candidates)
     floors = floors_for(rig.body_scale)
     asset = surface.asset
     skin = np.asarray(asset.skin)  # (V, 2): method code, trust radius

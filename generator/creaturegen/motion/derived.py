@@ -30,6 +30,7 @@ class Derived:
     land: int
     hop_cycle: int
     hop_idle: int
+    dip: float  # how far a hopper on legs sinks on them at the bottom of its crouch and landing, m
     v0: float
     apex: float
     flap_hz: float
@@ -76,6 +77,12 @@ def derive(data: dict[str, Any], gravity: list[float]) -> Derived:
     hop_cycle = busy + 1
     if speed > 0.0 and data["hopLength"] > 0.0:
         hop_cycle = max(busy + 1, ticks_from_seconds(data["hopLength"] / speed, hz))
+    dip = 0.0
+    if data["type"] == "hopper" and legs:
+        # The legs' mean rest hip height above their feet, times each leg's crouch fraction.
+        for leg in legs:
+            dip = dip + leg["crouch"] * (leg["hip"][1] - leg["foot"][1])
+        dip = dip / len(legs)
     t_half = half_air * dt
     v0 = g * t_half
     flap_hz = 0.0
@@ -104,6 +111,7 @@ def derive(data: dict[str, Any], gravity: list[float]) -> Derived:
         land=land,
         hop_cycle=hop_cycle,
         hop_idle=hop_cycle - busy,
+        dip=dip,
         v0=v0,
         apex=0.5 * g * t_half * t_half,
         flap_hz=flap_hz,

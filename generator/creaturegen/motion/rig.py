@@ -34,6 +34,15 @@ HOP_CROUCH_S: Final = 0.12
 HOP_LAND_S: Final = 0.12
 HOP_SQUASH: Final = 0.18
 HOP_STRETCH: Final = 0.12
+#: A hopper's legs at the apex of a hop: each foot drawn up toward its hip, the hip-foot distance this
+#: fraction of the way from the leg's shortest reach (reachMin) to its rest distance, so the knee folds
+#: (shipped per leg as the dimensionless ``tuck``, the tucked distance over the rest one).
+HOP_TUCK: Final = 0.55
+#: A hopper on legs also sinks on them in the crouch and the landing: the root drops by this fraction of
+#: the legs' mean rest hip height above their feet, on top of the squash (which shortens the legs with the
+#: body and alone bends a knee by a tenth of a degree), so the knees fold as the body lowers. Shipped per
+#: leg as ``crouch``; motion/derived.py turns it into the hop's ``dip`` (m).
+HOP_CROUCH_DEPTH: Final = 0.15
 #: Flap and undulation frequency from a Strouhal number ``f·A/U`` (A = tip excursion).
 STROUHAL: Final = 0.3
 #: Swimmer: critically damped response at ``SWIM_RESPONSE·√(g/L)`` rad/s.
@@ -121,6 +130,8 @@ def build_motion(spec: CharacterSpec, rig: CompiledRig, skeleton: Skeleton) -> d
         a = math.dist(hip, knee)
         b = math.dist(knee, foot)
         unit_hint = [c / norm for c in hint]
+        reach_min = abs(a - b) + REACH_MARGIN * (a + b)
+        drop = math.dist(hip, foot)
         reach = vq.normalize([foot[i] - hip[i] for i in range(3)])
         hinge = vq.normalize(vq.cross(reach, vq.gram_schmidt(unit_hint, reach)))
         legs.append(
@@ -138,8 +149,12 @@ def build_motion(spec: CharacterSpec, rig: CompiledRig, skeleton: Skeleton) -> d
                 # axis, so the bones never twist as the leg swings (see motion/ik.py).
                 "hinge": hinge,
                 "group": phases.index(float(part.phase or 0.0)),
-                "reachMin": abs(a - b) + REACH_MARGIN * (a + b),
+                "reachMin": reach_min,
                 "reachMax": (a + b) * (1.0 - REACH_MARGIN),
+                # A hopper's foot at the apex: hip + (foot − hip)·tuck (a ratio, so an individual's size
+                # scales it with hip and foot; motion/simulate.py _hop_legs).
+                "tuck": (reach_min + HOP_TUCK * (drop - reach_min)) / drop,
+                "crouch": HOP_CROUCH_DEPTH,
             }
         )
     ropes = []

@@ -6,7 +6,7 @@ Order of writes per tick (the seed's rule; the last stage touching a slot wins):
 2. base pose: per-slot local rotations composed down the skeleton (flyer bank and flap, swimmer
    undulation; identity otherwise);
 3. legs: gait plants feet in the support frame → world target → inverse root transform → body-frame IK
-   → creature-local leg slots;
+   → creature-local leg slots (a hopper's two legs plant together on the ground and tuck in the air);
 4. ropes: fixed-step verlet in world space, anchor following the posed body, written last.
 
 Integer ticks are authoritative: state at tick n is reached only by stepping from tick 0, so
@@ -185,7 +185,8 @@ class Motion:
         return lowest
 
     def _hop(self, n: int) -> tuple[float, float, float]:
-        """(distance along the path, height above the support, squash) of the hopper at tick ``n``."""
+        """(distance along the path, height above the support, squash) of the hopper at tick ``n``. In the
+        crouch and the landing a hopper on legs also sinks on them (``dip``, 0 without legs)."""
         d, c = self.d, self.data["constants"]
         hop_length = self.data["hopLength"] if self.data["speed"] > 0.0 else 0.0
         k, m = divmod(n, d.hop_cycle)
@@ -193,7 +194,8 @@ class Motion:
             return k * hop_length, 0.0, 1.0
         m -= d.hop_idle
         if m < d.crouch:
-            return k * hop_length, 0.0, 1.0 - c["hopSquash"] * psin(math.pi * (m / d.crouch))
+            sink = psin(math.pi * (m / d.crouch))
+            return k * hop_length, 0.0 - d.dip * sink, 1.0 - c["hopSquash"] * sink
         m -= d.crouch
         if m < d.air:
             ts = m * d.dt
@@ -202,7 +204,8 @@ class Motion:
             y = d.v0 * ts - 0.5 * d.g * ts * ts
             return k * hop_length + hop_length * tau, y, 1.0 + c["hopStretch"] * (e * e)
         m -= d.air
-        return (k + 1) * hop_length, 0.0, 1.0 - c["hopSquash"] * psin(math.pi * (m / d.land))
+        sink = psin(math.pi * (m / d.land))
+        return (k + 1) * hop_length, 0.0 - d.dip * sink, 1.0 - c["hopSquash"] * sink
 
     def root_at(self, n: int) -> tuple[Frame, list[float]]:
         """Support frame and root (x, y, z, cos yaw, sin yaw, squash) at tick ``n``."""
@@ -339,6 +342,9 @@ class Motion:
         return [home[0] + psin(psi) * offset, 0.0, home[2] + pcos(psi) * offset]
 
     def _gait(self, n: int, frame: Frame, integrate: bool) -> None:
+        if self.kind == "hopper":
+            self._hop_legs(n, frame, integrate)
+            return
         data, d, gates = self.data, self.d, self.gates
         step_length = data["stepLength"]
         lead = data["constants"]["stepLead"] * step_length
@@ -375,21 +381,70 @@ class Motion:
                     lift,
                     foot.s[2] + (foot.t[2] - foot.s[2]) * sigma,
                 ]
-            target = self.to_local_root(self.root, to_world(frame, local))
-            ik = solve_leg(leg, target)
-            self.quats[leg["upper"]], self.trans[leg["upper"]] = ik.q_upper, ik.t_upper
-            self.quats[leg["lower"]], self.trans[leg["lower"]] = ik.q_lower, ik.t_lower
-            span = leg["a"] + leg["b"]
-            gates.ik_residual = max(gates.ik_residual, ik.residual)
-            drawn = vq.rotate(ik.q_lower, leg["foot"])
-            drawn = [drawn[0] + ik.t_lower[0], drawn[1] + ik.t_lower[1], drawn[2] + ik.t_lower[2]]
-            gates.drawn_foot = max(gates.drawn_foot, vq.distance(drawn, ik.foot) / span)
-            if ik.clamped:
-                gates.clamped_ticks += 1
-            elif foot.planted:
-                back = to_local(frame, self.to_world_root(self.root, drawn))
-                gates.plant_drift = max(gates.plant_drift, vq.distance(back, foot.p) / span)
-                gates.planted_samples += 1
+            self._place_leg(leg, foot, self.to_local_root(self.root, to_world(frame, local)), frame)
+        self._count_planted(swinging)
+
+    def _hop_legs(self, n: int, frame: Frame, integrate: bool) -> None:
+        """A hopper's two hind legs, together: planted on the support while the body is on it (idle, crouch,
+        landing), their plants fixed in the support frame while the IK bends them under the sinking, squashed
+        body; airborne from the first air tick, when each foot leaves its take-off plant (s), is drawn up
+        toward its hip (``tuck`` of the rest hip-foot distance) at the apex and reaches for its landing plant
+        (t): the rest foot under the root at the landing tick, known in closed form when it takes off. The
+        target blends s and t (smoothstep σ(τ)) in the creature frame, pulled toward the tuck by
+        (4τ(1 − τ))², so a leg first stretches toward the ground it left (the push-off), then folds, then
+        stretches toward the ground ahead."""
+        d = self.d
+        m = n % d.hop_cycle
+        airborne = d.hop_idle + d.crouch <= m < d.hop_idle + d.crouch + d.air
+        swinging = 0
+        for leg, foot in zip(self.data["legs"], self.feet, strict=True):
+            if not integrate:
+                foot.planted, foot.p = True, self._home(leg, frame, self.root)
+            elif foot.planted and airborne:
+                foot.planted, foot.n0, foot.s = False, n, list(foot.p)
+                foot.t = self._home(leg, *self.root_at(n + d.air))
+                self.gates.steps += 1
+            elif not foot.planted and not airborne:
+                foot.planted, foot.p = True, list(foot.t)
+            if foot.planted:
+                target = self.to_local_root(self.root, to_world(frame, foot.p))
+            else:
+                swinging += 1
+                tau = (n - foot.n0) / d.air
+                sigma = tau * tau * (3.0 - 2.0 * tau)
+                arc = 4.0 * tau * (1.0 - tau)
+                pull = arc * arc
+                a = self.to_local_root(self.root, to_world(frame, foot.s))
+                b = self.to_local_root(self.root, to_world(frame, foot.t))
+                hip, rest, tuck = leg["hip"], leg["foot"], leg["tuck"]
+                target = [0.0, 0.0, 0.0]
+                for k in range(3):
+                    base = a[k] + (b[k] - a[k]) * sigma
+                    tucked = hip[k] + (rest[k] - hip[k]) * tuck
+                    target[k] = base + (tucked - base) * pull
+            self._place_leg(leg, foot, target, frame)
+        self._count_planted(swinging)
+
+    def _place_leg(self, leg: dict[str, Any], foot: Foot, target: Vec, frame: Frame) -> None:
+        """Two-bone IK toward ``target`` (creature frame) into the leg's slots, and the leg gates."""
+        gates = self.gates
+        ik = solve_leg(leg, target)
+        self.quats[leg["upper"]], self.trans[leg["upper"]] = ik.q_upper, ik.t_upper
+        self.quats[leg["lower"]], self.trans[leg["lower"]] = ik.q_lower, ik.t_lower
+        span = leg["a"] + leg["b"]
+        gates.ik_residual = max(gates.ik_residual, ik.residual)
+        drawn = vq.rotate(ik.q_lower, leg["foot"])
+        drawn = [drawn[0] + ik.t_lower[0], drawn[1] + ik.t_lower[1], drawn[2] + ik.t_lower[2]]
+        gates.drawn_foot = max(gates.drawn_foot, vq.distance(drawn, ik.foot) / span)
+        if ik.clamped:
+            gates.clamped_ticks += 1
+        elif foot.planted:
+            back = to_local(frame, self.to_world_root(self.root, drawn))
+            gates.plant_drift = max(gates.plant_drift, vq.distance(back, foot.p) / span)
+            gates.planted_samples += 1
+
+    def _count_planted(self, swinging: int) -> None:
+        gates = self.gates
         if len(self.feet) == 2 and swinging == 2:
             gates.both_swing_ticks += 1
         gates.fewest_planted = min(gates.fewest_planted, len(self.feet) - swinging)

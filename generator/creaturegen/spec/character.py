@@ -58,14 +58,13 @@ LOCOMOTION_FIELDS: dict[str, tuple[str, ...]] = {
     "swimmer": ("speed", "undulation", "buoyancy"),
 }
 
-#: locomotion type -> number of leg parts it drives; types not listed here nor in WALKER_LEG_COUNTS accept
-#: any count.
+#: locomotion type -> number of leg parts it drives; types not listed here, in WALKER_LEG_COUNTS nor in
+#: HOPPER_LEG_COUNTS accept any count.
 LEG_COUNTS: dict[str, int] = {
     "biped": 2,
     "quadruped": 4,
     "hexapod": 6,
     "octopod": 8,
-    "hopper": 0,
     "swimmer": 0,
 }
 
@@ -77,6 +76,11 @@ WALKERS: tuple[str, ...] = ("biped", "quadruped", "hexapod", "octopod", "walker"
 #: Leg counts of the generic ``walker``: left/right pairs, one to four of them. More legs than eight would
 #: outgrow a pose page's slot budget long before the gait cared.
 WALKER_LEG_COUNTS: tuple[int, ...] = (2, 4, 6, 8)
+
+#: Leg counts of a ``hopper``: none (the body hops on its own squash) or the two hind legs it hops on, a
+#: kangaroo's or a frog's. Both legs plant, push off, tuck and land together (motion/simulate.py
+#: _hop_legs), whatever their ``phase``.
+HOPPER_LEG_COUNTS: tuple[int, ...] = (0, 2)
 
 BLEND_KERNELS = ("log-sum-exp",)
 

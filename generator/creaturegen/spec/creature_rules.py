@@ -14,6 +14,7 @@ from typing import Any
 
 from .character import (
     COMMON_PART_FIELDS,
+    HOPPER_LEG_COUNTS,
     LEG_COUNTS,
     LOCOMOTION_FIELDS,
     SHAPE_FIELDS,
@@ -146,6 +147,14 @@ def locomotion(raw: dict[str, Any]) -> list[SpecError]:
     if kind in LEG_COUNTS and legs != LEG_COUNTS[kind]:
         errors.append(
             SpecError("locomotion.type", f"{kind} needs {LEG_COUNTS[kind]} leg parts, the spec has {legs}")
+        )
+    if kind == "hopper" and legs not in HOPPER_LEG_COUNTS:
+        errors.append(
+            SpecError(
+                "locomotion.type",
+                f"hopper needs {' or '.join(map(str, HOPPER_LEG_COUNTS))} leg parts (2: the two hind legs "
+                f"it hops on, as a kangaroo's or a frog's), the spec has {legs}",
+            )
         )
     if kind == "walker" and legs not in WALKER_LEG_COUNTS:
         low, high = WALKER_LEG_COUNTS[0], WALKER_LEG_COUNTS[-1]

@@ -18,7 +18,7 @@ import numpy as np
 import numpy.typing as npt
 
 from .. import __version__
-from ..candidates import TierRejectedError, build_candidates
+from ..candidates import CandidateSet, TierRejectedError, build_candidates
 from ..field import layout as col
 from ..motion.envelope import pose_envelope
 from ..rig import CompiledRig
@@ -114,6 +114,8 @@ class SurfaceBuild:
     cached: bool
     folder: Path | None = None
     timings: dict[str, float] = field(default_factory=dict)
+    # The tier's candidate programs when this build computed them (a cache hit leaves them to the plan).
+    candidates: CandidateSet | str | None = None
 
     @property
     def passed(self) -> bool:
@@ -144,15 +146,19 @@ def choose_backend(rig: CompiledRig, requested: str, progress: Progress) -> tupl
     return chosen, why
 
 
-def candidate_index(
-    spec: CharacterSpec, rig: CompiledRig, tier: str, rest: F64
-) -> tuple[npt.NDArray[np.int64], str]:
-    """Per vertex, the first candidate region (in program order) whose box holds its rest position."""
+def tier_candidates(spec: CharacterSpec, rig: CompiledRig, tier: str) -> CandidateSet | str:
+    """The tier's candidate programs, or why the tier has none (TierRejectedError's message)."""
     try:
-        found = build_candidates(spec, rig, tier)
+        return build_candidates(spec, rig, tier)
     except TierRejectedError as exc:
-        return np.full(rest.shape[0], NO_PROGRAM, dtype=np.int64), str(exc)
+        return str(exc)
+
+
+def candidate_index(found: CandidateSet | str, rest: F64) -> tuple[npt.NDArray[np.int64], str]:
+    """Per vertex, the first candidate region (in program order) whose box holds its rest position."""
     index = np.full(rest.shape[0], NO_PROGRAM, dtype=np.int64)
+    if isinstance(found, str):
+        return index, found
     for n, program in enumerate(found.programs):
         inside = np.all((rest >= np.asarray(program.lo)) & (rest <= np.asarray(program.hi)), axis=1)
         index[(index == NO_PROGRAM) & inside] = n
@@ -568,7 +574,8 @@ def _extract_surface(
     progress(f"deformation per joint: {counts} in {timings['deformation']:.2f} s")
 
     t = time.perf_counter()
-    programs, candidate_note = candidate_index(spec, rig, tier, mesh.vertices)
+    found = tier_candidates(spec, rig, tier)
+    programs, candidate_note = candidate_index(found, mesh.vertices)
     region, report, worst_skin, trust = correction_sweep(
         rig, mesh, ex.normals, (weights.indices, weights.weights), skeleton, choice, programs, envelope.poses
     )
@@ -673,7 +680,7 @@ def _extract_surface(
             sig.compilerSignature, sig.topologySignature, geometry, tier, settings, asset, sidecar
         )
     timings["total"] = time.perf_counter() - t0
-    return SurfaceBuild(tier, signatures, asset, sidecar, tuple(gates), False, folder, timings)
+    return SurfaceBuild(tier, signatures, asset, sidecar, tuple(gates), False, folder, timings, found)
 
 
 def _gate_rows(sidecar: dict[str, object]) -> list[dict[str, object]]:

@@ -119,7 +119,9 @@ COR_CHUNK: Final = 4096
 class DeformationError(Exception):
     """No skinning method passes a joint's sweep; the message names the joint and the failed gates."""
 
-    def __init__(self, joint: str, sweeps: Sequence[MethodSweep]) -> None:
+    def __init__(
+        self, joint: str, sweeps: Sequence[MethodSweep], bend_deg: float = 0.0, twist_deg: float = 0.0
+    ) -> None:
         self.joint = joint
         self.sweeps = tuple(sweeps)
         failed = "; ".join(
@@ -127,7 +129,14 @@ class DeformationError(Exception):
             + ", ".join(f"{g.name} {g.value:.4g} vs {g.threshold:.4g} {g.unit}" for g in s.failed)
             for s in sweeps
         )
-        super().__init__(f"{joint}: no skinning method passes the bend/twist sweep ({failed})")
+        reach = (
+            f"; the motion turns this joint up to {bend_deg:.0f}° bend and {twist_deg:.0f}° twist (swept "
+            "with its margin): a smaller turn (a shorter step or hop, a longer limb) or a thinner limb at "
+            "the joint keeps it within what skinning can carry"
+            if bend_deg or twist_deg
+            else ""
+        )
+        super().__init__(f"{joint}: no skinning method passes the bend/twist sweep ({failed}){reach}")
 
 
 # ---------------------------------------------------------------------------------------------- poses
@@ -989,16 +998,19 @@ def _joint_sweep(
         surface_p99 = np.percentile(error, 99, axis=2)
 
     labels = [label for label, _ in poses]
-    # The relative gates compare a method with the best method that keeps the joint at that pose: a
-    # collapsed LBS joint hugs the posed body from inside (its vertices pulled towards the pivot), so
-    # measuring DQ's or CoR's surface error and bulge against it charged them for not collapsing.
-    keeps = collapse >= COLLAPSE_MIN
     # The joint's scale: its radius, or the lever from the pivot to the seam where the pivot is buried
     # inside the parent (a hip), since every method's displacement, and so its artefacts, grows with the
     # lever as much as with the radius.
     scale = max(radius, closest)
     r_l = scale / length_scale
     ball = 4.0 / 3.0 * math.pi * radius**2 * scale
+    # The relative gates compare a method with the best method that keeps the joint at that pose, by its
+    # own gates there: no collapse, and for LBS no more volume lost than VOLUME_FACTOR of the joint ball.
+    # A collapsed or deflated LBS joint hugs the posed body from inside (vertices pulled towards the
+    # pivot), so measuring DQ's or CoR's surface error and bulge against it charged them for not
+    # collapsing (thick hips of wolves and elephants on the generated corpus).
+    keeps = collapse >= COLLAPSE_MIN
+    keeps[:, 0] &= (volume[:, 1] - volume[:, 0]) <= VOLUME_FACTOR * ball
     sweeps = []
     for k, method in enumerate(METHODS):
 
@@ -1118,7 +1130,7 @@ def choose_deformation(
         sweeps = result.sweeps
         chosen = next((s.method for s in sweeps if s.passed), None)
         if chosen is None:
-            raise DeformationError(skeleton.names[child], sweeps)
+            raise DeformationError(skeleton.names[child], sweeps, bend, twist)
         methods[child] = chosen
         radius = float(rig_slots[child, col.RA])
         joints.append(

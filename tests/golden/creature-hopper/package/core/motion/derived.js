@@ -33,6 +33,12 @@ export function derive(data, gravity) {
   const busy = crouch + air + land;
   let hopCycle = busy + 1;
   if (speed > 0 && data.hopLength > 0) hopCycle = Math.max(busy + 1, ticksFromSeconds(data.hopLength / speed, hz));
+  let dip = 0;
+  if (data.type === 'hopper' && data.legs.length) {
+    // The legs' mean rest hip height above their feet, times each leg's crouch fraction.
+    for (const leg of data.legs) dip = dip + leg.crouch * (leg.hip[1] - leg.foot[1]);
+    dip = dip / data.legs.length;
+  }
   const tHalf = halfAir * dt;
   let flapHz = 0;
   if (data.wings.length) {
@@ -46,7 +52,7 @@ export function derive(data, gravity) {
   const cosBank = radius > 0 ? lift / Math.sqrt(speed * speed * (speed * speed) + lift * lift) : 1;
   const undulation = data.undulation;
   return {
-    hz, dt, g, swing, window, cycle, halfAir, air, crouch, land, hopCycle, hopIdle: hopCycle - busy,
+    hz, dt, g, swing, window, cycle, halfAir, air, crouch, land, hopCycle, hopIdle: hopCycle - busy, dip,
     v0: g * tHalf,
     apex: 0.5 * g * tHalf * tHalf,
     flapHz,

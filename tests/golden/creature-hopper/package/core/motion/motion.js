@@ -6,7 +6,7 @@
 //   2. base pose: per-slot local rotations composed down the skeleton (flyer bank and flap, swimmer
 //      undulation; identity otherwise);
 //   3. legs: plant in the support frame → world target → inverse root transform → body-frame IK →
-//      creature-local leg slots;
+//      creature-local leg slots (a hopper's two legs plant together on the ground and tuck in the air);
 //   4. ropes: fixed-step verlet in world space, the anchor following the posed body, written last.
 // Integer ticks are authoritative: seekTick(n) resets and steps n times, so it equals n step() calls bit
 // for bit. Nothing allocates after createMotion (typed scratch only); the only variation is the seeded LCG.
@@ -85,6 +85,8 @@ export function createMotion(data, lcg, { support = createFlatGround(), gravity 
   const ahead = new Float64Array(3);
   const local = new Float64Array(3);
   const target = new Float64Array(3);
+  const airFrom = new Float64Array(3); // a hopper's airborne foot: its take-off and landing plants, creature frame
+  const airTo = new Float64Array(3);
   const hopOut = new Float64Array(3);
   const path = new Float64Array(3);
   const query = new Float64Array(3); // the water query (x, z, time): numbers in an array are never boxed
@@ -177,10 +179,11 @@ export function createMotion(data, lcg, { support = createFlatGround(), gravity 
     let r = n % d.hopCycle;
     if (r < d.hopIdle) { out[0] = k * hopLength; out[1] = 0; out[2] = 1; return; }
     r -= d.hopIdle;
+    // In the crouch and the landing a hopper on legs also sinks on them (d.dip, 0 without legs).
     if (r < d.crouch) {
       sc[2] = Math.PI * (r / d.crouch);
       sincos(sc, 2, sc, 0);
-      out[0] = k * hopLength; out[1] = 0; out[2] = 1 - c.hopSquash * sc[0]; return;
+      out[0] = k * hopLength; out[1] = 0 - d.dip * sc[0]; out[2] = 1 - c.hopSquash * sc[0]; return;
     }
     r -= d.crouch;
     if (r < d.air) {
@@ -195,7 +198,7 @@ export function createMotion(data, lcg, { support = createFlatGround(), gravity 
     r -= d.air;
     sc[2] = Math.PI * (r / d.land);
     sincos(sc, 2, sc, 0);
-    out[0] = (k + 1) * hopLength; out[1] = 0; out[2] = 1 - c.hopSquash * sc[0];
+    out[0] = (k + 1) * hopLength; out[1] = 0 - d.dip * sc[0]; out[2] = 1 - c.hopSquash * sc[0];
   }
 
   /** Support frame and root (x, y, z, cos yaw, sin yaw, squash) at tick n. */
@@ -406,6 +409,7 @@ export function createMotion(data, lcg, { support = createFlatGround(), gravity 
   }
 
   function gait(n, integrate) {
+    if (kind === 'hopper') { hopLegs(n, integrate); return; }
     const stepLength = m.stepLength;
     const lead = m.constants.stepLead * stepLength;
     const phase = n % d.cycle;
@@ -445,24 +449,85 @@ export function createMotion(data, lcg, { support = createFlatGround(), gravity 
       }
       toWorld(frame, local, 0, v3, 0);
       toLocalRoot(root, v3, 0, target, 0);
-      solveLeg(leg, target);
-      const span = leg.a + leg.b;
-      gv[G.ikResidual] = Math.max(gv[G.ikResidual], ik[7]);
-      rotate(quats, 4 * leg.lower, leg.foot, 0, v3, 0);
-      const lo = 3 * leg.lower;
-      const drawnX = v3[0] + trans[lo], drawnY = v3[1] + trans[lo + 1], drawnZ = v3[2] + trans[lo + 2];
-      const ex = drawnX - ik[3], ey = drawnY - ik[4], ez = drawnZ - ik[5];
-      gv[G.drawnFoot] = Math.max(gv[G.drawnFoot], Math.sqrt(ex * ex + ey * ey + ez * ez) / span);
-      if (ik[6]) gv[G.clampedTicks] += 1;
-      else if (planted[i]) {
-        n3[0] = drawnX; n3[1] = drawnY; n3[2] = drawnZ;
-        toWorldRoot(root, n3, 0, v3, 0);
-        toLocal(frame, v3, 0, w3, 0);
-        const px = w3[0] - plant[o], py = w3[1] - plant[o + 1], pz = w3[2] - plant[o + 2];
-        gv[G.plantDrift] = Math.max(gv[G.plantDrift], Math.sqrt(px * px + py * py + pz * pz) / span);
-        gv[G.plantedSamples] += 1;
-      }
+      placeLeg(leg, i);
     }
+    countPlanted(swinging);
+  }
+
+  // A hopper's two hind legs, together (motion/simulate.py _hop_legs): planted while the body is on the
+  // support (idle, crouch, landing); from the first air tick each foot leaves its take-off plant
+  // (swingFrom), is drawn up toward its hip (leg.tuck) at the apex and reaches for its landing plant
+  // (swingTo: the rest foot under the root at the landing tick). The target blends the two (smoothstep)
+  // in the creature frame, pulled toward the tuck by (4τ(1 − τ))².
+  function hopLegs(n, integrate) {
+    const r = n % d.hopCycle;
+    const airborne = d.hopIdle + d.crouch <= r && r < d.hopIdle + d.crouch + d.air;
+    let swinging = 0;
+    for (let i = 0; i < L; i++) {
+      const leg = m.legs[i];
+      const o = 3 * i;
+      if (!integrate) {
+        planted[i] = 1;
+        homeIn(leg, frame, root, home);
+        plant[o] = home[0]; plant[o + 1] = home[1]; plant[o + 2] = home[2];
+      } else if (planted[i] && airborne) {
+        planted[i] = 0; liftTick[i] = n;
+        swingFrom[o] = plant[o]; swingFrom[o + 1] = plant[o + 1]; swingFrom[o + 2] = plant[o + 2];
+        rootAt(n + d.air, frame2, root2);
+        homeIn(leg, frame2, root2, ahead);
+        swingTo[o] = ahead[0]; swingTo[o + 1] = ahead[1]; swingTo[o + 2] = ahead[2];
+        gv[G.steps] += 1;
+      } else if (!planted[i] && !airborne) {
+        planted[i] = 1; plant[o] = swingTo[o]; plant[o + 1] = swingTo[o + 1]; plant[o + 2] = swingTo[o + 2];
+      }
+      if (planted[i]) {
+        toWorld(frame, plant, o, v3, 0);
+        toLocalRoot(root, v3, 0, target, 0);
+      } else {
+        swinging += 1;
+        const tau = (n - liftTick[i]) / d.air;
+        const sigma = tau * tau * (3 - 2 * tau);
+        const arc = 4 * tau * (1 - tau);
+        const pull = arc * arc;
+        toWorld(frame, swingFrom, o, v3, 0);
+        toLocalRoot(root, v3, 0, airFrom, 0);
+        toWorld(frame, swingTo, o, v3, 0);
+        toLocalRoot(root, v3, 0, airTo, 0);
+        const hip = leg.hip, rest = leg.foot, tuck = leg.tuck;
+        for (let k = 0; k < 3; k++) {
+          const base = airFrom[k] + (airTo[k] - airFrom[k]) * sigma;
+          const tucked = hip[k] + (rest[k] - hip[k]) * tuck;
+          target[k] = base + (tucked - base) * pull;
+        }
+      }
+      placeLeg(leg, i);
+    }
+    countPlanted(swinging);
+  }
+
+  /** Two-bone IK of leg i toward `target` (creature frame) into its slots, and the leg gates. */
+  function placeLeg(leg, i) {
+    const o = 3 * i;
+    solveLeg(leg, target);
+    const span = leg.a + leg.b;
+    gv[G.ikResidual] = Math.max(gv[G.ikResidual], ik[7]);
+    rotate(quats, 4 * leg.lower, leg.foot, 0, v3, 0);
+    const lo = 3 * leg.lower;
+    const drawnX = v3[0] + trans[lo], drawnY = v3[1] + trans[lo + 1], drawnZ = v3[2] + trans[lo + 2];
+    const ex = drawnX - ik[3], ey = drawnY - ik[4], ez = drawnZ - ik[5];
+    gv[G.drawnFoot] = Math.max(gv[G.drawnFoot], Math.sqrt(ex * ex + ey * ey + ez * ez) / span);
+    if (ik[6]) gv[G.clampedTicks] += 1;
+    else if (planted[i]) {
+      n3[0] = drawnX; n3[1] = drawnY; n3[2] = drawnZ;
+      toWorldRoot(root, n3, 0, v3, 0);
+      toLocal(frame, v3, 0, w3, 0);
+      const px = w3[0] - plant[o], py = w3[1] - plant[o + 1], pz = w3[2] - plant[o + 2];
+      gv[G.plantDrift] = Math.max(gv[G.plantDrift], Math.sqrt(px * px + py * py + pz * pz) / span);
+      gv[G.plantedSamples] += 1;
+    }
+  }
+
+  function countPlanted(swinging) {
     if (L === 2 && swinging === 2) gv[G.bothSwingTicks] += 1;
     gv[G.fewestPlanted] = Math.min(gv[G.fewestPlanted], L - swinging);
   }
