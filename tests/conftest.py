@@ -87,6 +87,19 @@ def surface_cache_root(tmp_path_factory: pytest.TempPathFactory) -> Iterator[str
 
 
 @pytest.fixture(scope="session", autouse=True)
+def one_envelope_process() -> Iterator[None]:
+    """The pytest workers already fill the machine's cores: builds step their motion envelope in-process
+    ($CREATUREGEN_WORKERS, motion/envelope.py); test_motion_envelope.py sets it to test the worker path."""
+    previous = os.environ.get("CREATUREGEN_WORKERS")
+    os.environ["CREATUREGEN_WORKERS"] = "1"
+    yield
+    if previous is None:
+        os.environ.pop("CREATUREGEN_WORKERS", None)
+    else:
+        os.environ["CREATUREGEN_WORKERS"] = previous
+
+
+@pytest.fixture(scope="session", autouse=True)
 def no_build_pictures() -> Iterator[None]:
     """Builds in tests skip the README picture (a Chromium launch each) through $CREATUREGEN_PICTURE;
     test_creature_picture.py asks for it explicitly with --picture on."""

@@ -119,3 +119,14 @@ def test_the_disk_copy_is_the_measured_envelope_bit_for_bit() -> None:
     tail = [s for s, part in enumerate(rig.slot_parts) if part == "counter-tail"]
     assert np.all(env.slot_displacement[tail] > 0.0)
     assert rig.slots[tail[0], col.RA] > 0.0
+
+
+def test_worker_processes_do_not_change_the_envelope(monkeypatch: pytest.MonkeyPatch) -> None:
+    """Runs stepped by forked workers come back in run order with the very floats stepped in-process."""
+    _spec, rig, data, skeleton = _load("reference/flyer.json")
+    measured = []
+    for workers in ("1", "3"):
+        monkeypatch.setenv(envelope.WORKERS_ENV, workers)
+        measured.append(envelope._to_json(envelope.measure_envelope(data, rig.slots, skeleton)))
+    assert envelope.envelope_workers(2) == 2  # at most one process per run
+    assert measured[0] == measured[1]

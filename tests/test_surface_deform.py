@@ -329,7 +329,8 @@ def test_choice_never_returns_lbs_where_its_sweep_failed(
 
 def test_relative_gates_compare_with_a_method_that_keeps_the_joint() -> None:
     """A collapsed LBS joint hugs the posed body from inside; DQ's bulge and surface error are measured
-    against the best method that keeps the joint (here CoR), not against the collapsed one."""
+    against the best method that keeps the joint (here CoR), not against the collapsed one. (The sweep
+    marks a method once for the whole sweep: one that collapses at some pose is no alternative.)"""
     values = np.array([[0.001, 0.010, 0.006], [0.002, 0.003, 0.004]])
     keeps = np.array([[False, True, True], [True, True, True]])
     excess = deform._excess(values, keeps)

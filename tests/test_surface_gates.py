@@ -370,6 +370,19 @@ def test_bumpy_mesh_fails_normal_angles(sphere: Mesh) -> None:
     assert not {"surfaceToZeroSet", "zeroSetToMesh", "inverted"} & failed
 
 
+def test_a_fused_field_changes_no_gate(sphere: Mesh) -> None:
+    """``field`` (distance and gradient in one pass, as BodyField.field) only saves evaluations."""
+
+    def field(p: F64) -> tuple[F64, F64]:
+        return sphere_distance(p), sphere_gradient(p)
+
+    plain = mesh_gates(sphere, length_scale=L, distance=sphere_distance, gradient=sphere_gradient)
+    fused = mesh_gates(
+        sphere, length_scale=L, distance=sphere_distance, gradient=sphere_gradient, field=field
+    )
+    assert [(g.as_dict(), g.where) for g in fused] == [(g.as_dict(), g.where) for g in plain]
+
+
 # ------------------------------------------------------------------------------- exact predicates
 
 

@@ -30,6 +30,7 @@ from typing import Any
 
 from .. import __version__
 from ..candidates import TIERS
+from ..motion.envelope import WORKERS_ENV, usable_cpus
 from .random import random_creature
 
 PACKAGE_ROOT = Path(__file__).resolve().parent.parent
@@ -106,11 +107,13 @@ def parse_refusal(stderr: str) -> dict[str, Any]:
     return result
 
 
-def run_job(job: Job, packages: Path, timeout: float = BUILD_TIMEOUT_S) -> dict[str, Any]:
-    """One cold ``creaturegen build`` in its own process and its own surface cache."""
+def run_job(job: Job, packages: Path, timeout: float = BUILD_TIMEOUT_S, workers: int = 1) -> dict[str, Any]:
+    """One cold ``creaturegen build`` in its own process and its own surface cache, stepping its motion
+    envelope in ``workers`` processes (motion/envelope.py: the outcome does not depend on it)."""
     out = packages / job.tier
     with tempfile.TemporaryDirectory(prefix="creaturegen-corpus-") as cache_dir:
         env = {**os.environ, "CREATUREGEN_CACHE": cache_dir, "PYTHONUNBUFFERED": "1"}
+        env.setdefault(WORKERS_ENV, str(workers))
         command = [
             sys.executable,
             "-m",
@@ -290,9 +293,11 @@ def run_corpus(
     )
     started = time.perf_counter()
     done = len(work) - len(todo)
+    # Builds side by side share the cores; each steps its envelope in its share of them.
+    workers = max(1, usable_cpus() // max(1, jobs))
     with ThreadPoolExecutor(max_workers=max(1, jobs)) as pool:
         futures: dict[Future[dict[str, Any]], Job] = {
-            pool.submit(run_job, job, packages): job for job in todo
+            pool.submit(run_job, job, packages, workers=workers): job for job in todo
         }
         for future in _as_completed(futures):
             job = futures[future]

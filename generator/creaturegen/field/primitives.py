@@ -18,6 +18,7 @@ the GPU path rather than a float64 result cast down at the end.
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from functools import cached_property
 from typing import Any, NamedTuple, TypeAlias
 
@@ -28,6 +29,11 @@ from . import layout
 
 FloatArray: TypeAlias = npt.NDArray[np.floating[Any]]
 BoolArray: TypeAlias = npt.NDArray[np.bool_]
+IndexArray: TypeAlias = npt.NDArray[np.intp]
+#: A vector field as three same-shaped arrays, one per coordinate.
+Components: TypeAlias = tuple[FloatArray, FloatArray, FloatArray]
+#: The fallback directions (N, 3) of the short radial vectors at (slot rows, points) ``at``.
+Fallback: TypeAlias = Callable[[tuple[IndexArray, IndexArray]], FloatArray]
 
 #: Taper slope ``|s| = |rb − ra| / |b − a|`` above which a slot uses the exact round cone.
 #:
@@ -66,7 +72,8 @@ def primitive_field(
     dtype: npt.DTypeLike = np.float64,
     gradient_floor: float = GRADIENT_FLOOR,
 ) -> tuple[FloatArray, FloatArray]:
-    """Distance ``d`` of shape (S, P) and unnormalised gradient ``g`` of shape (S, P, 3).
+    """Distance ``d`` of shape (S, P) and unnormalised gradient ``g`` of shape (S, P, 3) (a view of a
+    (3, S, P) array: each coordinate is written as one contiguous block).
 
     Each slot is evaluated in the form ``slot_uses_round_cone`` picks for it; see the module
     docstring for why the gradient keeps its norm.
@@ -76,11 +83,14 @@ def primitive_field(
     dt = _float_dtype(dtype)
     round_cone = slot_uses_round_cone(table)
     d = np.empty((table.shape[0], pts.shape[0]), dtype=dt)
-    g = np.empty((table.shape[0], pts.shape[0], 3), dtype=dt)
-    for mask, form in ((~round_cone, tapered_capsule_field), (round_cone, round_cone_field)):
+    g = np.empty((3, table.shape[0], pts.shape[0]), dtype=dt)
+    for mask, form in ((~round_cone, _tapered_field), (round_cone, _round_cone_field)):
         if mask.any():
-            d[mask], g[mask] = form(table[mask], pts, dt, gradient_floor)
-    return d, g
+            rows = _rows(mask)
+            d[rows], gradient = form(_Frame(table[rows], pts, dt, gradient_floor))
+            for k in range(3):
+                g[k, rows] = gradient[k]
+    return d, g.transpose(1, 2, 0)
 
 
 def primitive_distance(
@@ -93,11 +103,16 @@ def primitive_distance(
     dt = _float_dtype(dtype)
     round_cone = slot_uses_round_cone(table)
     d = np.empty((table.shape[0], pts.shape[0]), dtype=dt)
-    if (~round_cone).any():
-        d[~round_cone] = _tapered_distance(_Frame(table[~round_cone], pts, dt, GRADIENT_FLOOR)).d
-    if round_cone.any():
-        d[round_cone] = _round_cone_distance(_Frame(table[round_cone], pts, dt, GRADIENT_FLOOR)).d
+    for mask, form in ((~round_cone, _tapered_distance), (round_cone, _round_cone_distance)):
+        if mask.any():
+            rows = _rows(mask)
+            d[rows] = form(_Frame(table[rows], pts, dt, GRADIENT_FLOOR)).d
     return d
+
+
+def _rows(mask: BoolArray) -> slice | IndexArray:
+    """The slots ``mask`` selects: every slot as a slice (views and block copies, no gather)."""
+    return slice(None) if mask.all() else np.flatnonzero(mask)
 
 
 def tapered_capsule_field(
@@ -114,16 +129,28 @@ def tapered_capsule_field(
     end point. A sphere is the zero-length case: ``t = 0``, radial from ``a``.
     """
     fr = _Frame(_check_slots(slots), _check_points(points), _float_dtype(dtype), gradient_floor)
+    d, g = _tapered_field(fr)
+    return d, np.stack(g, axis=-1)
+
+
+def _tapered_field(fr: _Frame) -> tuple[FloatArray, Components]:
     d, q, q_len = _tapered_distance(fr)
     # Strict inequalities: on the seams t is unchanged by the clamp, so the side formula holds there as
     # a one-sided derivative, and an axis point at t = 0 falls back like the round cone's side does.
     below, above = fr.t_raw < 0.0, fr.t_raw > 1.0
-    fallback = np.where(below[..., None], -fr.axis, np.where(above[..., None], fr.axis, fr.perpendicular))
+
+    def fallback(at: tuple[IndexArray, IndexArray]) -> FloatArray:
+        axis = fr.axis[at[0], 0]
+        result: FloatArray = np.where(
+            below[at][:, None], -axis, np.where(above[at][:, None], axis, fr.perpendicular[at[0], 0])
+        )
+        return result
+
     q_hat = _unit(q, q_len, fr.floor, fallback)
     interior = ~(below | above)
     slope = np.where(interior, fr.slope, 0.0)
-    g = q_hat - slope[..., None] * fr.axis
-    return d, g
+    g = tuple(q_hat[k] - slope * fr.axis[..., k] for k in range(3))
+    return d, (g[0], g[1], g[2])
 
 
 def round_cone_field(
@@ -145,19 +172,34 @@ def round_cone_field(
     exactly, since ``√(L·L) = L`` in IEEE arithmetic) both return bit-identical results.
     """
     fr = _Frame(_check_slots(slots), _check_points(points), _float_dtype(dtype), gradient_floor)
+    d, g = _round_cone_field(fr)
+    return d, np.stack(g, axis=-1)
+
+
+def _round_cone_field(fr: _Frame) -> tuple[FloatArray, Components]:
     d, q, x, sn, c, pb, pa_len, pb_len, cap_a, cap_b = _round_cone_distance(fr)
-    g_a = _unit(fr.pa, pa_len, fr.floor, -fr.axis)
-    g_b = _unit(pb, pb_len, fr.floor, fr.axis)
-    g_side = c[..., None] * _unit(q, x, fr.floor, fr.perpendicular) + sn[..., None] * fr.axis
-    g = np.where(cap_a[..., None], g_a, np.where(cap_b[..., None], g_b, g_side))
-    return d, g
+
+    def constant(direction: FloatArray) -> Fallback:
+        def fallback(at: tuple[IndexArray, IndexArray]) -> FloatArray:
+            result: FloatArray = direction[at[0], 0]
+            return result
+
+        return fallback
+
+    g_a = _unit(fr.pa, pa_len, fr.floor, constant(-fr.axis))
+    g_b = _unit(pb, pb_len, fr.floor, constant(fr.axis))
+    u = _unit(q, x, fr.floor, constant(fr.perpendicular))
+    g = tuple(
+        np.where(cap_a, g_a[k], np.where(cap_b, g_b[k], c * u[k] + sn * fr.axis[..., k])) for k in range(3)
+    )
+    return d, (g[0], g[1], g[2])
 
 
 class _TaperedCore(NamedTuple):
     """The tapered form's distance and the radial vector its gradient reuses."""
 
     d: FloatArray
-    q: FloatArray
+    q: Components
     x: FloatArray  # |q|
 
 
@@ -165,11 +207,11 @@ class _ConeCore(NamedTuple):
     """The round cone's distance, its region masks and what its gradient reuses."""
 
     d: FloatArray
-    q: FloatArray
+    q: Components
     x: FloatArray
     sn: FloatArray  # side normal's axial part
     c: FloatArray  # side normal's radial part
-    pb: FloatArray  # p − b
+    pb: Components  # p − b
     pa_len: FloatArray
     pb_len: FloatArray
     cap_a: BoolArray
@@ -178,8 +220,8 @@ class _ConeCore(NamedTuple):
 
 def _tapered_distance(fr: _Frame) -> _TaperedCore:
     t = np.clip(fr.t_raw, 0.0, 1.0)
-    q = fr.pa - fr.ba * t[..., None]
-    x = _norm(q)
+    q = _along(fr.pa, fr.ba, t)
+    x = _norm_xyz(q)
     return _TaperedCore(x - (fr.ra + (fr.rb - fr.ra) * t), q, x)
 
 
@@ -189,23 +231,24 @@ def _round_cone_distance(fr: _Frame) -> _ConeCore:
     with np.errstate(divide="ignore", invalid="ignore"):
         sn = np.where(nested, 0.0, dr / fr.length)
         c = np.where(nested, 1.0, np.sqrt(np.maximum((fr.length - dr) * (fr.length + dr), 0.0)) / fr.length)
-    q = fr.pa - fr.ba * fr.t_raw[..., None]
-    x = _norm(q)
+    q = _along(fr.pa, fr.ba, fr.t_raw)
+    x = _norm_xyz(q)
     cl = c * fr.length
     cap_a = ~nested & (cl * fr.t_raw < sn * x)
     cap_b = ~nested & (cl * (fr.t_raw - 1.0) > sn * x)
     # Nested: the larger end sphere, taking a on a tie of radii.
     cap_a = cap_a | (nested & (fr.ra >= fr.rb))
     cap_b = cap_b | (nested & (fr.ra < fr.rb))
-    pb = fr.pa - fr.ba
-    pa_len, pb_len = _norm(fr.pa), _norm(pb)
+    pb = (fr.pa[0] - fr.ba[..., 0], fr.pa[1] - fr.ba[..., 1], fr.pa[2] - fr.ba[..., 2])
+    pa_len, pb_len = _norm_xyz(fr.pa), _norm_xyz(pb)
     side_d = sn * (fr.t_raw * fr.length) + c * x - fr.ra
     d = np.where(cap_a, pa_len - fr.ra, np.where(cap_b, pb_len - fr.rb, side_d))
     return _ConeCore(d, q, x, sn, c, pb, pa_len, pb_len, cap_a, cap_b)
 
 
 class _Frame:
-    """Per-slot geometry (shape (S, 1, …)) and per-point projections (shape (S, P, …)), in one dtype.
+    """Per-slot geometry (shape (S, 1, …)) and per-point projections (shape (S, P), one array per
+    coordinate: contiguous rows run several times faster than (S, P, 3) strides), in one dtype.
 
     Degenerate directions follow one deterministic rule, so the output is finite everywhere and the
     same on every run:
@@ -221,7 +264,7 @@ class _Frame:
 
     def __init__(self, slots: FloatArray, points: FloatArray, dtype: np.dtype[Any], floor: float) -> None:
         table = slots.astype(dtype)
-        pts = points.astype(dtype)[None, :, :]
+        pts = points.astype(dtype)
         a = table[:, None, layout.A]
         self.ba = table[:, None, layout.B] - a
         self.ra = table[:, None, layout.RA]
@@ -230,9 +273,10 @@ class _Frame:
         scale = self.length + np.maximum(self.ra, self.rb)
         self.floor = np.maximum(floor * scale, np.finfo(dtype).tiny)
         self.degenerate = self.length <= self.floor
-        self.pa = pts - a
+        pa = tuple(pts[None, :, k] - a[..., k] for k in range(3))
+        self.pa: Components = (pa[0], pa[1], pa[2])
         length_sq = np.where(self.degenerate, 1.0, _dot(self.ba, self.ba))
-        self.t_raw = np.where(self.degenerate, 0.0, _dot(self.pa, self.ba) / length_sq)
+        self.t_raw = np.where(self.degenerate, 0.0, _dot_xyz(self.pa, self.ba) / length_sq)
 
     # Only the gradient needs these; the distance-only path never computes them.
     @cached_property
@@ -267,10 +311,34 @@ def _perpendicular(axis: FloatArray) -> FloatArray:
     return result
 
 
-def _unit(v: FloatArray, length: FloatArray, floor: FloatArray, fallback: FloatArray) -> FloatArray:
+def _unit(v: Components, length: FloatArray, floor: FloatArray, fallback: Fallback) -> Components:
+    """``v / length`` per coordinate; where ``length <= floor`` (rare) the fallback direction instead."""
     short = length <= floor
     safe = np.where(short, 1.0, length)
-    result: FloatArray = np.where(short[..., None], fallback, v / safe[..., None])
+    unit = [v[k] / safe for k in range(3)]
+    if short.any():
+        rows, points = np.nonzero(short)
+        at = (rows, points)
+        direction = fallback(at)
+        for k in range(3):
+            unit[k][at] = direction[:, k]
+    return unit[0], unit[1], unit[2]
+
+
+def _along(pa: Components, ba: FloatArray, t: FloatArray) -> Components:
+    """``pa − ba·t`` per coordinate (the radial vector from the axis point at ``t``)."""
+    return pa[0] - ba[..., 0] * t, pa[1] - ba[..., 1] * t, pa[2] - ba[..., 2] * t
+
+
+def _dot_xyz(u: Components, v: FloatArray) -> FloatArray:
+    """``_dot`` of per-coordinate arrays with a (…, 3) vector: the same products, summed in the same order."""
+    result: FloatArray = u[0] * v[..., 0] + u[1] * v[..., 1] + u[2] * v[..., 2]
+    return result
+
+
+def _norm_xyz(v: Components) -> FloatArray:
+    """``_norm`` of per-coordinate arrays."""
+    result: FloatArray = np.sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2])
     return result
 
 

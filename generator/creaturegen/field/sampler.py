@@ -74,8 +74,8 @@ def evaluate_graph(graph: BlendGraph, d_slots: Array, g_slots: Array) -> tuple[A
     return d, g
 
 
-def evaluate_distance(graph: BlendGraph, d_slots: Array) -> Array:
-    """The body's distance alone, bit-identical to ``evaluate_graph``'s; no gradient is formed."""
+def evaluate_op_distances(graph: BlendGraph, d_slots: Array) -> list[Array]:
+    """Every op's distance in program order, bit-identical to ``evaluate_ops``'s; no gradient is formed."""
     values: list[Array] = []
     for op in graph.ops:
         ds = [d_slots[c.index] if c.kind == "slot" else values[c.index] for c in op.children]
@@ -84,6 +84,12 @@ def evaluate_distance(graph: BlendGraph, d_slots: Array) -> Array:
         else:
             d, _ = lse_smin_distance(np.stack(ds), op.k)
         values.append(d)
+    return values
+
+
+def evaluate_distance(graph: BlendGraph, d_slots: Array) -> Array:
+    """The body's distance alone, bit-identical to ``evaluate_graph``'s; no gradient is formed."""
+    values = evaluate_op_distances(graph, d_slots)
     roots = np.stack([d_slots[r.index] if r.kind == "slot" else values[r.index] for r in graph.roots])
     result: Array = roots[np.argmin(roots, axis=0), np.arange(roots.shape[1])]
     return result

@@ -38,6 +38,7 @@ import hashlib
 import itertools
 import json
 import math
+import multiprocessing
 import os
 from dataclasses import dataclass
 from functools import cache
@@ -82,6 +83,8 @@ STILL_DEG: Final = 1e-3
 STILL_DRIFT: Final = 1e-9
 #: Headings a run starts at on a support that is not the same in every direction.
 HEADINGS: Final = 4
+#: Environment variable: how many processes step the envelope's runs (see envelope_workers).
+WORKERS_ENV: Final = "CREATUREGEN_WORKERS"
 
 
 @dataclass(frozen=True)
@@ -235,22 +238,76 @@ def individual(data: dict[str, Any], support: Support, seed: int, genome: Genome
     return Motion(data, support=support, water=water, genome=genome, seed=seed)
 
 
+def _step_run(motion: Motion, ticks: int) -> tuple[F64, F64]:
+    """One run's samples: quaternions (ticks + 1, S, 4) wxyz and translations (ticks + 1, S, 3) of the
+    unit body (the individual's divided by its size), tick 0 first."""
+    quats: list[float] = []
+    trans: list[float] = []
+    for tick in range(ticks + 1):
+        if tick:
+            motion.step()
+        quats.extend(itertools.chain.from_iterable(motion.quats))
+        trans.extend(itertools.chain.from_iterable(motion.trans))
+    slots = len(motion.quats)
+    xyzw = np.asarray(quats, dtype=np.float64).reshape(ticks + 1, slots, 4)
+    unit: F64 = np.asarray(trans, dtype=np.float64).reshape(ticks + 1, slots, 3) / motion.size
+    return xyzw[..., [3, 0, 1, 2]], unit
+
+
+#: In a forked worker: the runs it may step and the ticks per run (its copy of the parent's).
+_FORKED: tuple[list[Motion], int] | None = None
+
+
+def _adopt(motions: list[Motion], ticks: int) -> None:
+    global _FORKED
+    _FORKED = (motions, ticks)
+
+
+def _step_forked(index: int) -> tuple[F64, F64]:
+    assert _FORKED is not None
+    motions, ticks = _FORKED
+    return _step_run(motions[index], ticks)
+
+
+def usable_cpus() -> int:
+    """The CPUs this process may run on."""
+    affinity = getattr(os, "sched_getaffinity", None)
+    return len(affinity(0)) if affinity is not None else os.cpu_count() or 1
+
+
+def envelope_workers(runs: int) -> int:
+    """Processes that step the runs: ``$CREATUREGEN_WORKERS`` when it is a positive integer, else the
+    usable CPUs, at most one per run. Each run is independent and stepped by the same code, so the
+    samples do not depend on how many there are (the corpus runner sets its builds' share of the CPUs)."""
+    wanted = os.environ.get(WORKERS_ENV, "").strip()
+    count = int(wanted) if wanted.isdigit() and int(wanted) > 0 else usable_cpus()
+    return max(1, min(count, runs))
+
+
+def _step_runs(motions: list[Motion], ticks: int, workers: int) -> list[tuple[F64, F64]]:
+    """Every run's samples in run order, stepped here or, with ``workers`` > 1 where fork is available,
+    by forked worker processes (each steps its own copy of the runs; these are left unstepped)."""
+    if workers <= 1 or "fork" not in multiprocessing.get_all_start_methods():
+        return [_step_run(motion, ticks) for motion in motions]
+    # A forked child inherits the runs as they are (nothing is pickled on the way in); the samples come
+    # back pickled, bit for bit, and map keeps the run order.
+    context = multiprocessing.get_context("fork")
+    with context.Pool(workers, initializer=_adopt, initargs=(motions, ticks)) as pool:
+        return pool.map(_step_forked, range(len(motions)), chunksize=1)
+
+
 def _record(
-    data: dict[str, Any], runs: list[tuple[str, Motion]]
+    data: dict[str, Any], runs: list[tuple[str, Motion]], workers: int = 1
 ) -> tuple[list[str], int, F64, F64, list[str]]:
     """(run labels, ticks per run, quaternions (N, S, 4) wxyz, translations (N, S, 3) of the unit body,
     sample labels)."""
     ticks = run_ticks(data)
-    labels, quats, trans, sample_labels = [], [], [], []
-    for label, motion in runs:
-        labels.append(label)
-        for tick in range(ticks + 1):
-            if tick:
-                motion.step()
-            quats.append([[q[3], q[0], q[1], q[2]] for q in motion.quats])
-            trans.append([[c / motion.size for c in t] for t in motion.trans])
-            sample_labels.append(f"{label} tick {tick}")
-    return labels, ticks, np.asarray(quats), np.asarray(trans), sample_labels
+    labels = [label for label, _ in runs]
+    stepped = _step_runs([motion for _, motion in runs], ticks, workers)
+    sample_labels = [f"{label} tick {tick}" for label in labels for tick in range(ticks + 1)]
+    quats = np.concatenate([q for q, _ in stepped]) if stepped else np.zeros((0, 0, 4))
+    trans = np.concatenate([t for _, t in stepped]) if stepped else np.zeros((0, 0, 3))
+    return labels, ticks, quats, trans, sample_labels
 
 
 def _root_frame(quats: F64, trans: F64, root: int) -> tuple[F64, F64]:
@@ -299,9 +356,14 @@ def _farthest(points: F64, count: int, first: int) -> list[int]:
 def measure_envelope(
     data: dict[str, Any], rest: F64, skeleton: Skeleton, runs: list[tuple[str, Motion]] | None = None
 ) -> PoseEnvelope:
-    """Step every run (by default :func:`envelope_runs`), measure every joint and slot, and pick the
-    whole-body sweep poses."""
-    labels, ticks, quats, trans, sample_labels = _record(data, envelope_runs(data) if runs is None else runs)
+    """Step every run (by default :func:`envelope_runs`, stepped by :func:`envelope_workers` processes),
+    measure every joint and slot, and pick the whole-body sweep poses. Runs passed in are stepped here."""
+    if runs is None:
+        runs = envelope_runs(data)
+        workers = envelope_workers(len(runs))
+    else:
+        workers = 1
+    labels, ticks, quats, trans, sample_labels = _record(data, runs, workers)
     root = int(data["roots"][0])
     q, t = _root_frame(quats, trans, root)
     joints = tuple(_joint(skeleton, rest, q, t, p, c) for p, c in skeleton.joints)

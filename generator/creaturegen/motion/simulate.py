@@ -115,6 +115,8 @@ class Motion:
         self.theta0 = -yaw
         self.position = [float(c) for c in position]
         self.slot_count = len(data["parent"])
+        # The base pose of a body without local rotations (see _base_pose), composed on first use.
+        self._rest_pose: tuple[list[list[float]], list[Vec]] | None = None
         self.reset()
 
     # --- state -----------------------------------------------------------------------------------
@@ -294,6 +296,15 @@ class Motion:
 
     def _base_pose(self, time: float) -> None:
         data, d = self.data, self.d
+        if self.kind != "flyer" and not (self.kind == "swimmer" and d.undulation_hz > 0.0):
+            # No local rotation at any time: the same pose every tick, composed once (then copied).
+            if self._rest_pose is None:
+                self._compose_base({})
+                self._rest_pose = ([list(q) for q in self.quats], [list(t) for t in self.trans])
+            quats, trans = self._rest_pose
+            for s in data["order"]:
+                self.quats[s], self.trans[s] = list(quats[s]), list(trans[s])
+            return
         locals_: dict[int, list[float]] = {}
         if self.kind == "flyer":
             for r in data["roots"]:
@@ -305,6 +316,11 @@ class Motion:
             angle = data["undulation"] * psin(2.0 * math.pi * d.undulation_hz * time)
             for r in data["roots"]:
                 locals_[r] = vq.axis_angle(Y_AXIS, angle)
+        self._compose_base(locals_)
+
+    def _compose_base(self, locals_: dict[int, list[float]]) -> None:
+        """Per-slot local rotations (identity where absent) composed down the skeleton about the pivots."""
+        data = self.data
         parent, pivot = data["parent"], data["pivot"]
         for s in data["order"]:
             local = locals_.get(s, list(vq.IDENTITY))
@@ -486,6 +502,7 @@ class Motion:
         passes alone leave a whipped tail stretched and bent past its limit; the skin is certified for the
         poses this bounds (motion/envelope.py)."""
         seg, c_max, s_max, radius = rope["segment"], rope["bendCos"], rope["bendSin"], rope["radius"]
+        ground = self.data["ropeGround"]
         a = cur[0]
         px, py, pz = a[0] - before[0], a[1] - before[1], a[2] - before[2]
         n = math.sqrt(px * px + py * py + pz * pz)
@@ -509,23 +526,22 @@ class Motion:
                     uy = c_max * py + s_max * (wy / wn)
                     uz = c_max * pz + s_max * (wz / wn)
             cur[j] = [a[0] + seg * ux, a[1] + seg * uy, a[2] + seg * uz]
-            if self.data["ropeGround"]:
+            if ground and _height(frame, cur[j]) < radius[j]:
+                # Lift the node onto the support at radius height, swinging the segment about its
+                # first node so its length holds (the bend may open past the limit there).
                 x = to_local(frame, cur[j])
-                if x[1] < radius[j]:
-                    # Lift the node onto the support at radius height, swinging the segment about its
-                    # first node so its length holds (the bend may open past the limit there).
-                    o = to_local(frame, a)
-                    dy = min(seg, max(-seg, radius[j] - o[1]))
-                    dx, dz = x[0] - o[0], x[2] - o[2]
-                    flat = math.sqrt(dx * dx + dz * dz)
-                    wide = math.sqrt(max(seg * seg - dy * dy, 0.0))
-                    if flat == 0.0:
-                        dx, dz = wide, 0.0
-                    else:
-                        dx, dz = dx * (wide / flat), dz * (wide / flat)
-                    cur[j] = to_world(frame, [o[0] + dx, o[1] + dy, o[2] + dz])
-                    b = cur[j]
-                    ux, uy, uz = (b[0] - a[0]) / seg, (b[1] - a[1]) / seg, (b[2] - a[2]) / seg
+                o = to_local(frame, a)
+                dy = min(seg, max(-seg, radius[j] - o[1]))
+                dx, dz = x[0] - o[0], x[2] - o[2]
+                flat = math.sqrt(dx * dx + dz * dz)
+                wide = math.sqrt(max(seg * seg - dy * dy, 0.0))
+                if flat == 0.0:
+                    dx, dz = wide, 0.0
+                else:
+                    dx, dz = dx * (wide / flat), dz * (wide / flat)
+                cur[j] = to_world(frame, [o[0] + dx, o[1] + dy, o[2] + dz])
+                b = cur[j]
+                ux, uy, uz = (b[0] - a[0]) / seg, (b[1] - a[1]) / seg, (b[2] - a[2]) / seg
             px, py, pz = ux, uy, uz
 
     def _ropes(self, frame: Frame, integrate: bool) -> None:
@@ -543,6 +559,8 @@ class Motion:
         substeps, passes, keep = c["ropeSubsteps"], c["ropePasses"], 1.0 - c["ropeDamping"]
         h = d.dt / substeps
         gx, gy, gz = g[0] * h * h, g[1] * h * h, g[2] * h * h
+        ground = self.data["ropeGround"]
+        f0, f1, f2, n0, n1, n2 = frame[0], frame[1], frame[2], frame[6], frame[7], frame[8]
         for index, rope in enumerate(self.data["ropes"]):
             cur, prev = self.nodes[index], self.prev_nodes[index]
             anchor_local = self._anchor_point(rope, 0)
@@ -572,10 +590,11 @@ class Motion:
                                 cur[j] = [a[0] + dx * hf, a[1] + dy * hf, a[2] + dz * hf]
                                 cur[j + 1] = [b[0] - dx * hf, b[1] - dy * hf, b[2] - dz * hf]
                         self._bend(cur, before, bend_min)
-                        if self.data["ropeGround"]:
+                        if ground:
                             for j in range(1, len(cur)):
-                                u, h, w = to_local(frame, cur[j])
-                                if h < radius[j]:
+                                x = cur[j]  # its height above the support is to_local(frame, x)[1]:
+                                if (x[0] - f0) * n0 + (x[1] - f1) * n1 + (x[2] - f2) * n2 < radius[j]:
+                                    u, _, w = to_local(frame, x)
                                     cur[j] = to_world(frame, [u, radius[j], w])
                     self._follow(cur, before, rope, frame)
             local = [self.to_local_root(self.root, x) for x in cur]
@@ -621,6 +640,12 @@ class Motion:
             values += [1.0 if foot.planted else 0.0, *foot.p, *foot.s, *foot.t, float(foot.n0)]
         values += [self.swim_y, self.swim_vy, self.centre[0], self.centre[2]]
         return hash_bytes(struct.pack(f"<{len(values)}d", *values), self.tick)
+
+
+def _height(f: Frame, p: Vec) -> float:
+    """``to_local(f, p)[1]`` alone (the same products and sums): the height above the support, which the
+    rope's ground test reads for every node, the tangential coordinates only where a node is lifted."""
+    return (p[0] - f[0]) * f[6] + (p[1] - f[1]) * f[7] + (p[2] - f[2]) * f[8]
 
 
 def hash_bytes(data: bytes, tick: int) -> str:

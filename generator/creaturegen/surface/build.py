@@ -285,6 +285,7 @@ def surface_mesh_gates(
         length_scale=rig.body_scale,
         distance=rest_field.distance,
         gradient=rest_field.gradient,
+        field=rest_field.field,
         expected_components=policy.expected,
         min_angle_bound_deg=MIN_ANGLE_P1_DEG,
         vertex_normal_max_deg=VERTEX_NORMAL_MAX_DEG,
@@ -517,24 +518,25 @@ def _extract_surface(
     """Extract, gate, weight, choose deformations and correct: the cold path of build_surface."""
     geometry, settings, extra = key.geometry, key.settings, key.extra
     t0 = time.perf_counter()
+    # The envelope first: it may step its runs in forked processes (motion/envelope.py), which is safe
+    # only before the sampling backend has started a GPU device's threads.
+    envelope = pose_envelope(spec, rig)
+    envelope_seconds = time.perf_counter() - t0
+    progress(
+        f"motion envelope: {len(envelope.runs)} runs × {envelope.ticks} ticks "
+        f"({envelope.samples:,} poses measured)"
+    )
     chosen, why = choose_backend(rig, backend, progress)
     rest_field = BodyField(rig.graph, rig.slots)
     skeleton = build_skeleton(spec, rig)
     validated = validated_mesh(rig, skeleton, tier, chosen, why, progress)
     ex, gates, policy, grid = validated.extraction, validated.gates, validated.policy, validated.grid
     mesh, refinement, sampling, timings = ex.mesh, validated.refinement, validated.sampling, validated.timings
+    timings["envelope"] = envelope_seconds
     if policy.detached:
         progress(f"declared: {', '.join(policy.detached)} detached from the body (the field leaves a gap)")
     if strict:
         _fail_on(gates, f"surface {tier}")
-
-    t = time.perf_counter()
-    envelope = pose_envelope(spec, rig)
-    timings["envelope"] = time.perf_counter() - t
-    progress(
-        f"motion envelope: {len(envelope.runs)} runs × {envelope.ticks} ticks "
-        f"({envelope.samples:,} poses measured)"
-    )
 
     t = time.perf_counter()
     weights = skin_weights(mesh, rest_field, skeleton, still=envelope.still_joints(rig.body_scale))

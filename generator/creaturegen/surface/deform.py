@@ -1004,13 +1004,15 @@ def _joint_sweep(
     scale = max(radius, closest)
     r_l = scale / length_scale
     ball = 4.0 / 3.0 * math.pi * radius**2 * scale
-    # The relative gates compare a method with the best method that keeps the joint at that pose, by its
-    # own gates there: no collapse, and for LBS no more volume lost than VOLUME_FACTOR of the joint ball.
-    # A collapsed or deflated LBS joint hugs the posed body from inside (vertices pulled towards the
-    # pivot), so measuring DQ's or CoR's surface error and bulge against it charged them for not
-    # collapsing (thick hips of wolves and elephants on the generated corpus).
+    # The relative gates compare a method with the best of the methods that could be chosen instead: those
+    # that keep the joint at every pose of the sweep by their own gates (no collapse, and for LBS no more
+    # volume lost than VOLUME_FACTOR of the joint ball). A collapsed or deflated joint hugs the posed body
+    # from inside (vertices pulled towards the pivot), so measuring DQ's or CoR's surface error and bulge
+    # against it charged them for not collapsing, and a method that collapses at some pose is no
+    # alternative at any other (thick hips of wolves and elephants, knees on slopes, on the corpus).
     keeps = collapse >= COLLAPSE_MIN
     keeps[:, 0] &= (volume[:, 1] - volume[:, 0]) <= VOLUME_FACTOR * ball
+    keeps = np.broadcast_to(keeps.all(axis=0), keeps.shape)
     sweeps = []
     for k, method in enumerate(METHODS):
 
@@ -1060,8 +1062,8 @@ def _worst(column: F64, labels: Sequence[str], low: bool = False) -> tuple[float
 
 
 def _excess(values: F64, keeps: Bools | None = None) -> F64:
-    """(P, 3) per pose, each method's value above the best (smallest) of the methods that keep the joint
-    at that pose (``keeps``: joint_collapse passes), or of all three where none does."""
+    """(P, 3) per pose, each method's value above the best (smallest) of the methods marked in ``keeps``
+    at that pose (the methods that keep the joint over the whole sweep), or of all three where none is."""
     if keeps is None:
         keeps = np.ones(values.shape, dtype=bool)
     usable = np.where(keeps.any(axis=1, keepdims=True), keeps, True)

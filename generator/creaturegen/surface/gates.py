@@ -47,6 +47,8 @@ DistanceFn = Callable[[F64], F64]
 #: something; the normal gates skip the other points and say how many.
 SmoothFn = Callable[[F64], npt.NDArray[np.bool_]]
 GradientFn = Callable[[F64], F64]
+#: Distance and gradient in one pass (points → (d, ∇d)); the values ``DistanceFn`` and ``GradientFn`` give.
+FieldFn = Callable[[F64], tuple[F64, F64]]
 Direction = Literal["max", "min"]
 
 AREA_EPS_FACTOR = 1e-12
@@ -139,12 +141,26 @@ def vertex_normals(mesh: Mesh) -> F64:
 
 
 def project_to_zero_set(
-    points: F64, distance: DistanceFn, gradient: GradientFn, steps: int, tol: float
-) -> tuple[F64, npt.NDArray[np.bool_]]:
-    """Newton onto the zero set (field64.newton_project); returns the points and which ended with
-    |d| < tol. The gates measure only converged points, so a bad seed cannot fake a failure."""
-    p, d, _ = newton_project(lambda q: (distance(q), gradient(q)), points, steps)
-    return p, np.abs(d) < tol
+    points: F64,
+    distance: DistanceFn,
+    gradient: GradientFn,
+    steps: int,
+    tol: float,
+    *,
+    field: FieldFn | None = None,
+    initial: tuple[F64, F64] | None = None,
+) -> tuple[F64, npt.NDArray[np.bool_], F64]:
+    """Newton onto the zero set (field64.newton_project); returns the points, which ended with
+    |d| < tol and the gradient there. The gates measure only converged points, so a bad seed cannot
+    fake a failure. ``field`` (distance and gradient in one pass) and ``initial`` (its values at
+    ``points``, already known) save evaluations and change no value."""
+    fused = field if field is not None else _fused(distance, gradient)
+    p, d, g = newton_project(fused, points, steps, initial)
+    return p, np.abs(d) < tol, g
+
+
+def _fused(distance: DistanceFn, gradient: GradientFn) -> FieldFn:
+    return lambda q: (distance(q), gradient(q))
 
 
 def surface_samples(mesh: Mesh, table: topology.EdgeTable) -> tuple[F64, I64]:
@@ -214,12 +230,14 @@ def mesh_gates(
     face_normal_p99_deg: float = FACE_NORMAL_P99_DEG,
     seed: int = 0,
     smooth: SmoothFn | None = None,
+    field: FieldFn | None = None,
 ) -> list[SurfaceGate]:
     """All gates, in a fixed order; distances are reported as fractions of ``length_scale`` (L).
 
     ``distance(points (N,3)) -> (N,)`` and ``gradient(points) -> (N,3)`` are the analytic field in float64
-    (the gradient need not be unit length). Every gate is always evaluated, so one report lists every
-    failure at once.
+    (the gradient need not be unit length); ``field(points) -> (d, g)``, when given, must return exactly
+    those two in one pass (BodyField.field), which the Newton projections use. Every gate is always
+    evaluated, so one report lists every failure at once.
     """
     table = topology.edge_table(mesh.faces)
     bvh = triangle_bvh(mesh)
@@ -244,6 +262,7 @@ def mesh_gates(
         ),
         seed=seed,
         smooth=smooth,
+        field=field,
     )
     return gates
 
@@ -386,6 +405,7 @@ def field_gates(
     normal_limits: Sequence[float],
     seed: int,
     smooth: SmoothFn | None = None,
+    field: FieldFn | None = None,
 ) -> list[SurfaceGate]:
     """Gates against the analytic field: orientation, two-sided distance, normal agreement."""
     length = float(length_scale)
@@ -393,8 +413,11 @@ def field_gates(
     corners = mesh.corners()
     centroids = corners.mean(axis=1)
     fn = mesh.face_normals()
+    fused = field if field is not None else _fused(distance, gradient)
 
-    inverted = np.flatnonzero(np.einsum("ij,ij->i", fn, gradient(centroids)) <= 0)
+    # The field at the centroids serves the orientation gate and starts their projection below.
+    at_centroids = fused(centroids)
+    inverted = np.flatnonzero(np.einsum("ij,ij->i", fn, at_centroids[1]) <= 0)
 
     samples, owner = surface_samples(mesh, table)
     residual = np.abs(distance(samples)) if samples.size else np.zeros(0)
@@ -403,7 +426,7 @@ def field_gates(
 
     normals = vertex_normals(mesh)
     seeds = coverage_seeds(mesh, normals, length, np.random.default_rng(seed))
-    on_set, converged = project_to_zero_set(seeds, distance, gradient, NEWTON_STEPS, tol)
+    on_set, converged, _ = project_to_zero_set(seeds, distance, gradient, NEWTON_STEPS, tol, field=fused)
     on_set = on_set[converged]
     if on_set.shape[0] and mesh.face_count:
         gap = zero_set_to_mesh(mesh, bvh, on_set)
@@ -419,14 +442,16 @@ def field_gates(
         coverage_detail = f"no seed of {seeds.shape[0]} converged onto the zero set"
 
     used = np.unique(mesh.faces.reshape(-1)).astype(np.int64)
-    feet, _ = project_to_zero_set(centroids, distance, gradient, NEWTON_STEPS, tol)
+    feet, _, at_feet = project_to_zero_set(
+        centroids, distance, gradient, NEWTON_STEPS, tol, field=fused, initial=at_centroids
+    )
     face_ids = np.arange(mesh.face_count, dtype=np.int64)
     if smooth is not None:
         used = used[smooth(mesh.vertices[used])]
         keep = smooth(feet)
-        face_ids, feet, fn = face_ids[keep], feet[keep], fn[keep]
+        face_ids, feet, fn, at_feet = face_ids[keep], feet[keep], fn[keep], at_feet[keep]
     vertex_angles = angles_deg(normals[used], gradient(mesh.vertices[used]))
-    face_angles = angles_deg(fn, gradient(feet))
+    face_angles = angles_deg(fn, at_feet)
 
     vmax, vp99, fmax, fp99 = normal_limits
     return [
