@@ -10,6 +10,7 @@ import shutil
 import subprocess
 import sys
 from collections.abc import Iterator
+from contextlib import contextmanager
 from dataclasses import dataclass
 from pathlib import Path
 from types import ModuleType
@@ -71,45 +72,44 @@ def shared_folder(factory: pytest.TempPathFactory, name: str) -> Path:
     return factory.mktemp(name)
 
 
+@contextmanager
+def environment(name: str, value: str) -> Iterator[None]:
+    """``$name`` set to ``value`` (seen by CLI children too) for the block, then as it was."""
+    previous = os.environ.get(name)
+    os.environ[name] = value
+    try:
+        yield
+    finally:
+        if previous is None:
+            os.environ.pop(name, None)
+        else:
+            os.environ[name] = previous
+
+
 @pytest.fixture(scope="session", autouse=True)
 def surface_cache_root(tmp_path_factory: pytest.TempPathFactory) -> Iterator[str]:
     """One surface cache for the whole run, also seen by CLI children through $CREATUREGEN_CACHE:
     every example is extracted once, whichever test (or worker) builds it first (surface, package or
     parity); SurfaceCache.building makes a second worker wait for the first one's entry."""
     root = str(shared_folder(tmp_path_factory, "surface-cache"))
-    previous = os.environ.get("CREATUREGEN_CACHE")
-    os.environ["CREATUREGEN_CACHE"] = root
-    yield root
-    if previous is None:
-        os.environ.pop("CREATUREGEN_CACHE", None)
-    else:
-        os.environ["CREATUREGEN_CACHE"] = previous
+    with environment("CREATUREGEN_CACHE", root):
+        yield root
 
 
 @pytest.fixture(scope="session", autouse=True)
 def one_envelope_process() -> Iterator[None]:
     """The pytest workers already fill the machine's cores: builds step their motion envelope in-process
     ($CREATUREGEN_WORKERS, motion/envelope.py); test_motion_envelope.py sets it to test the worker path."""
-    previous = os.environ.get("CREATUREGEN_WORKERS")
-    os.environ["CREATUREGEN_WORKERS"] = "1"
-    yield
-    if previous is None:
-        os.environ.pop("CREATUREGEN_WORKERS", None)
-    else:
-        os.environ["CREATUREGEN_WORKERS"] = previous
+    with environment("CREATUREGEN_WORKERS", "1"):
+        yield
 
 
 @pytest.fixture(scope="session", autouse=True)
 def no_build_pictures() -> Iterator[None]:
     """Builds in tests skip the README picture (a Chromium launch each) through $CREATUREGEN_PICTURE;
     test_creature_picture.py asks for it explicitly with --picture on."""
-    previous = os.environ.get("CREATUREGEN_PICTURE")
-    os.environ["CREATUREGEN_PICTURE"] = "off"
-    yield
-    if previous is None:
-        os.environ.pop("CREATUREGEN_PICTURE", None)
-    else:
-        os.environ["CREATUREGEN_PICTURE"] = previous
+    with environment("CREATUREGEN_PICTURE", "off"):
+        yield
 
 
 @pytest.fixture(scope="session")
