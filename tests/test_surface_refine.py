@@ -15,7 +15,7 @@ def test_every_lattice_gets_the_first_refinements() -> None:
 
 
 def test_extra_refinements_only_while_the_lattice_is_small() -> None:
-    small = _grid(49)  # 117,649 nodes: the eyed hopper of corpus seed 10 at refinement 2
+    small = _grid(49)  # 49³ = 117,649 nodes
     assert _may_refine(MAX_REFINEMENTS, small)
     assert not _may_refine(MAX_REFINEMENTS + EXTRA_REFINEMENTS, small)
     big = _grid(121)  # 1.77 M nodes, 5.0 M after a √2 refinement

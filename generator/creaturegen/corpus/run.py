@@ -22,7 +22,7 @@ import sys
 import tempfile
 import time
 from collections.abc import Iterable, Sequence
-from concurrent.futures import Future, ThreadPoolExecutor
+from concurrent.futures import Future, ThreadPoolExecutor, as_completed
 from dataclasses import dataclass
 from functools import cache
 from pathlib import Path
@@ -48,7 +48,8 @@ _PART = re.compile(r"part\.([A-Za-z][A-Za-z0-9_-]*)")
 
 @cache
 def compiler_digest() -> str:
-    """sha256 over the compiler's Python source and templates: what a build's outcome depends on."""
+    """sha256 over the compiler's Python source and templates: what a build's outcome depends on (wider
+    than surface/identity.py source_digest, which keys the surface cache by the surface's own packages)."""
     h = hashlib.sha256(__version__.encode())
     roots = [PACKAGE_ROOT]
     templates = PACKAGE_ROOT.parent.parent / "templates"
@@ -62,7 +63,8 @@ def compiler_digest() -> str:
 
 
 def write_specs(folder: Path, seeds: Iterable[int], locomotion: str | None = None) -> list[Path]:
-    """One ``<slug>.json`` per seed (pretty-printed, as a person would save it)."""
+    """One ``seed-NNNNN.json`` per seed (pretty-printed, as a person would save it); a file already holding
+    the same text is left alone."""
     folder.mkdir(parents=True, exist_ok=True)
     paths = []
     for seed in seeds:
@@ -97,8 +99,6 @@ def parse_refusal(stderr: str) -> dict[str, Any]:
     result: dict[str, Any] = {"message": message[:2000], "parts": sorted(set(_PART.findall(message)))}
     if "no skinning method passes" in message:
         result["gate"] = "deform.sweep"
-    elif "lattice cells along one axis" in message:
-        result["gate"] = "latticeLimit"
     if found:
         result["gate"] = found["gate"]
         result["value"] = float(found["value"])
@@ -299,7 +299,7 @@ def run_corpus(
         futures: dict[Future[dict[str, Any]], Job] = {
             pool.submit(run_job, job, packages, workers=workers): job for job in todo
         }
-        for future in _as_completed(futures):
+        for future in as_completed(futures):
             job = futures[future]
             record = future.result()
             (results / f"{job.key()}.json").write_text(json.dumps(record, indent=1, sort_keys=True))
@@ -341,12 +341,6 @@ def run_corpus(
     (out / "report.json").write_text(json.dumps(report, indent=1, sort_keys=True))
     (out / "index.html").write_text(_gallery(report, specs_info))
     return report
-
-
-def _as_completed(futures: dict[Future[dict[str, Any]], Job]) -> Iterable[Future[dict[str, Any]]]:
-    from concurrent.futures import as_completed
-
-    return as_completed(futures)
 
 
 def main(argv: Sequence[str] | None = None) -> int:

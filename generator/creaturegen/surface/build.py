@@ -70,8 +70,7 @@ CREASE_BAND_CELLS = 2.0
 MAX_REFINEMENTS = 2
 #: ... and further ones, up to EXTRA_REFINEMENTS more, while the lattice stays under SMALL_LATTICE_NODES
 #: nodes: a small body with a narrow fillet (eyes sunk into a small head) needs a few more halvings than a
-#: big one and they cost little (the refuses this turned into builds on the generated corpus were all
-#: below 0.2 M nodes; a hero octopod's first lattice is 6 M).
+#: big one, and on a small lattice they cost little; a big body's refinements are the expensive ones.
 EXTRA_REFINEMENTS = 3
 SMALL_LATTICE_NODES = 2_000_000
 #: Calibration points for picking the faster sampling backend.

@@ -29,8 +29,8 @@ ERROR_TARGET = {"hero": 0.06, "repeated": 0.125, "distant": 0.25}
 #: Largest lattice extent along any axis; beyond it the target is unreachable at load-time cost.
 MAX_CELLS_PER_AXIS = 640
 #: Largest first lattice: a body whose sagitta target asks for more starts here, and refinements (each √2
-#: finer) go on up to MAX_CELLS_PER_AXIS. A 640-cell first lattice on a 30 cm biped with 5 mm horn tips
-#: made 307 k vertices and took minutes; the mesh gates decide whether the coarser one will do.
+#: finer) go on up to MAX_CELLS_PER_AXIS. Vertices grow with the square of the cell count, so a first try at
+#: the limit costs about twice as much as one here; the mesh gates decide whether the coarser one will do.
 FIRST_CELLS_LIMIT = 448
 #: Fine cells per narrow-band block edge.
 BLOCK = 8

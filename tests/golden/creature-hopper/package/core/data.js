@@ -2844,7 +2844,7 @@ export const CREATURE = Object.freeze({
     0
   ],
   "signatures": {
-    "compilerSignature": "1dd09827bfcdc0b0604dd55931b31b99d5fa45c631bf54a55aa7525d6bbea56d",
+    "compilerSignature": "2efa5d0ca28e88572b0d4e9fd698bb78fdc45fc8dacc8db039f42f51c3e6cc88",
     "geometryDigest": "400b0d18a2a9f6bbbfe5b441f89767f552a4f3b4c45a368d1129d632e1d2f4f1",
     "topologySignature": "330d551e8c006f84b01459c84db69ca8c43aec5bc9d9083d3e85c291be5a68bf"
   },
