@@ -11,7 +11,7 @@ PYTHON ?= python3
 VENV := .venv
 VENV_PY := $(VENV)/bin/python
 VENV_STAMP := $(VENV)/.installed
-WEB_LAB := web_lab
+WEB_LAB := generator/creaturegen/web_lab
 NODE_STAMP := $(WEB_LAB)/node_modules/.package-lock.json
 # The default example is a creature (the product's spine); frost effects build the same way.
 EXAMPLE ?= examples/reference/hopper.json

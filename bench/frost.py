@@ -48,7 +48,7 @@ from creaturegen.lab.frost_session import FrostLab
 from creaturegen.lab.server import serve
 
 REPO = Path(__file__).resolve().parents[1]
-WEB_LAB = REPO / "web_lab"
+WEB_LAB = REPO / "generator" / "creaturegen" / "web_lab"
 TIER_SPEC = REPO / "examples" / "frost" / "frost-full.json"
 SPARSE_BASE_SPEC = REPO / "examples" / "frost" / "frost-budgeted.json"
 TIERS = ("full", "balanced", "budgeted")

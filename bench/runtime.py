@@ -52,7 +52,7 @@ from creaturegen.lab.browser import LabPage, launch_lab_page
 from creaturegen.lab.server import serve
 
 REPO = Path(__file__).resolve().parents[1]
-WEB_LAB = REPO / "web_lab"
+WEB_LAB = REPO / "generator" / "creaturegen" / "web_lab"
 HOPPER_SPEC = REPO / "examples" / "reference" / "hopper.json"
 HOPPER_SLUG = "hopper-squash-core"
 DEFAULT_PACKAGE = REPO / "out" / HOPPER_SLUG

@@ -25,7 +25,7 @@ from creaturegen.lab.browser import find_chromium, launch_lab_page
 from creaturegen.lab.server import serve
 
 REPO_ROOT = Path(__file__).resolve().parents[1]
-WEB_LAB = REPO_ROOT / "web_lab"
+WEB_LAB = REPO_ROOT / "generator" / "creaturegen" / "web_lab"
 THREE_VERSION = "0.185.1"
 
 # Mirrors web_lab/smoke.js: out[i] = sin(i * 0.01) * i + 1 over N float32 elements.

@@ -23,6 +23,7 @@ import pytest
 from conftest import EXAMPLES, REPO, node, run_cli, run_node_tests
 from creaturegen import __version__, cli
 from creaturegen.creature import pose as pose_module
+from creaturegen.creature.assets import shipped_spec, surface_path
 from creaturegen.creature.genome import draw_genome, genetics_data, genome_colours, slot_lab
 from creaturegen.emit.lint import Finding, lint_package, lint_sources, shipped_sources
 from creaturegen.emit.render import to_json
@@ -50,11 +51,14 @@ LAYOUT = (
     "core/pose.js",
     "core/index.d.ts",
     "tsl/index.js",
-    "assets/surface.glb",
+    "tsl/index.d.ts",
+    "tsl/asset.js",
+    "core/surface.js",
+    "examples/minimal.js",
     "assets/surface.json",
     "build-report.json",
 )
-#: A verbatim copy of the input spec: its bytes are what the header's sha256 names, so it has no header.
+#: The input spec (minus a $schema that would not resolve in the package): no header, it is the input.
 VERBATIM = "assets/spec.json"
 #: Module specifiers of import/export statements, bare imports and dynamic import() calls.
 IMPORT_SPECIFIER = re.compile(
@@ -94,6 +98,7 @@ def hopper(tmp_path_factory: pytest.TempPathFactory) -> Path:
 
 def test_layout(hopper: Path) -> None:
     files = tree(hopper)
+    assert surface_path(hopper).relative_to(hopper).as_posix() in files
     missing = [name for name in LAYOUT if name not in files]
     assert not missing, missing
     empty = [name for name in LAYOUT if not files[name]]
@@ -111,9 +116,12 @@ def test_package_json(hopper: Path) -> None:
     assert package["type"] == "module"
     exports = package["exports"]
     assert {".", "./core", "./tsl"} <= set(exports)
-    assert package["peerDependencies"] == {"three": ">=0.185.0 <0.186.0"}
-    targets = [package["main"], package["types"], exports["./tsl"]]
-    for entry in (exports["."], exports["./core"]):
+    release = ">=0.185.0 <0.186.0"
+    assert package["peerDependencies"] == {"three": release, "@types/three": release}
+    assert package["peerDependenciesMeta"] == {"@types/three": {"optional": True}}
+    assert package["license"] == "MIT"
+    targets = [package["main"], package["types"]]
+    for entry in (exports["."], exports["./core"], exports["./tsl"]):
         assert set(entry) == {"types", "default"}, "typed entry points name their .d.ts"
         targets += [entry["types"], entry["default"]]
     for target in targets:
@@ -135,7 +143,7 @@ def test_every_generated_file_carries_the_header(hopper: Path) -> None:
             assert content.startswith(f"<!-- {line} -->\n".encode()), f"{name}: {content[:120]!r}"
             checked["comment"].append(name)
         elif name == VERBATIM:
-            assert content == spec_bytes, f"{name} is not the input spec byte for byte"
+            assert content == shipped_spec(spec_bytes), f"{name} is not the input spec"
         elif name.endswith(".json"):
             value = json.loads(content)
             assert isinstance(value, dict), name
@@ -502,5 +510,5 @@ def test_golden_record(hopper: Path) -> None:
         "(.venv/bin/python tools/regen-golden.py), review the diff and commit tests/golden/."
     )
     manifest = json.loads(stored[golden.BINARY_MANIFEST])
-    assert set(manifest["files"]) == {"assets/surface.glb"}
+    assert set(manifest["files"]) == {surface_path(hopper).relative_to(hopper).as_posix()}
     assert any(name.startswith("package/core/") for name in stored)

@@ -1,13 +1,15 @@
 """`creaturegen build` on frost specs: the package layout, its determinism and hygiene, hostile names,
-invalid specs and the build report."""
+invalid specs and the build report; what `npm pack` publishes (size, files, links, the README snippet)."""
 
 from __future__ import annotations
 
+import hashlib
 import json
 import re
 import shutil
 import subprocess
-from pathlib import Path
+from pathlib import Path, PurePosixPath
+from typing import Any
 
 import pytest
 
@@ -24,13 +26,26 @@ LAYOUT = (
     "core/plan.js",
     "core/frost-core.js",
     "core/index.js",
+    "core/index.d.ts",
+    "core/revision.js",
+    "core/structure-file.js",
+    "tsl/assets.js",
     "tsl/frost-effect.js",
     "tsl/separable-blur.js",
     "tsl/index.js",
-    "assets/structure.bin",
-    "assets/normals.bin",
+    "tsl/index.d.ts",
+    "examples/minimal.js",
     "build-report.json",
 )
+
+#: The published package of frost-full must stay this small (it was 1.53 MB with raw RGBA8 maps).
+PACKED_LIMIT = 500_000
+
+#: `<slug>-<role>-<12 hex digits of the file's sha256>.<ext>`
+ASSET_NAME = re.compile(r"^(?P<slug>[a-z0-9-]+)-(?P<role>structure)-(?P<digest>[0-9a-f]{12})\.bin$")
+#: A URL resolved against the module: the only form bundlers follow is a plain string literal.
+STATIC_ASSET_URL = re.compile(r"""new URL\(\s*(['"])\.\./assets/([^'"`$]+)\1\s*,\s*import\.meta\.url\s*\)""")
+DYNAMIC_URL = re.compile(r"new URL\(\s*(`|[A-Za-z_$])")
 
 #: Clock and randomness reads in any spelling: `Math.random`, `performance?.now`, `Date['now']`, ...
 NONDETERMINISM = re.compile(
@@ -81,11 +96,152 @@ def test_package_json(built: dict[str, Path], example: str) -> None:
     spec = json.loads((EXAMPLES / "frost" / f"{example}.json").read_text())
     assert package["name"] == slugify(spec["name"]) == folder.name
     assert package["type"] == "module"
-    assert {".", "./core", "./tsl"} <= set(package["exports"])
-    assert package["peerDependencies"] == {"three": ">=0.185.0 <0.186.0"}
+    assert package["license"] == "MIT"
+    assert package["peerDependencies"] == {
+        "three": ">=0.185.0 <0.186.0",
+        "@types/three": ">=0.185.0 <0.186.0",
+    }
+    assert package["peerDependenciesMeta"] == {"@types/three": {"optional": True}}
     exports = package["exports"]
-    for target in (package["main"], package["types"], exports["./core"], exports["./tsl"]):
-        assert (folder / target).is_file(), target
+    for entry, stem in ((".", "index"), ("./core", "core/index"), ("./tsl", "tsl/index")):
+        assert exports[entry] == {"types": f"./{stem}.d.ts", "default": f"./{stem}.js"}, entry
+        for target in exports[entry].values():
+            assert (folder / target).is_file(), target
+    assert (folder / package["main"]).is_file()
+    assert (folder / package["types"]).is_file()
+    assert "build-report.json" not in package["files"]
+    for entry in package["files"]:
+        assert (folder / entry).exists(), f"files lists {entry}, which the build did not write"
+
+
+def npm_pack(folder: Path) -> dict[str, Any]:
+    """What `npm pack` would publish: name, size (the .tgz bytes) and the file list."""
+    npm = shutil.which("npm")
+    assert npm is not None, "npm must be on PATH"
+    done = subprocess.run(
+        [npm, "pack", "--dry-run", "--json"],
+        cwd=folder,
+        capture_output=True,
+        text=True,
+        check=False,
+        timeout=120,
+    )
+    assert done.returncode == 0, done.stderr
+    packed: dict[str, Any] = json.loads(done.stdout)[0]
+    return packed
+
+
+@pytest.mark.parametrize("example", FROST_EXAMPLES)
+def test_npm_pack_publishes_the_runtime_and_nothing_else(built: dict[str, Path], example: str) -> None:
+    folder = built[example]
+    packed = npm_pack(folder)
+    files = packed["files"]
+    assert isinstance(files, list)
+    published = {str(f["path"]) for f in files}
+    expected = {name for name in tree(folder) if name != "build-report.json"}
+    assert published == expected
+    assert not any(name.startswith("parity/") for name in published)
+    if example == "frost-full":
+        size = packed["size"]
+        assert isinstance(size, int)
+        assert size <= PACKED_LIMIT, f"frost-full packs to {size} bytes (limit {PACKED_LIMIT})"
+
+
+@pytest.mark.parametrize("example", FROST_EXAMPLES)
+def test_asset_names_carry_the_slug_and_a_content_digest(built: dict[str, Path], example: str) -> None:
+    folder = built[example]
+    report = json.loads((folder / "build-report.json").read_text())
+    assets = sorted((folder / "assets").iterdir())
+    assert [p.name for p in assets] == [report["assets"]["structure"]["file"]]
+    for path in assets:
+        match = ASSET_NAME.match(path.name)
+        assert match is not None, path.name
+        assert match["slug"] == folder.name
+        assert hashlib.sha256(path.read_bytes()).hexdigest()[:12] == match["digest"]
+
+
+def test_asset_names_never_collide_between_packages(built: dict[str, Path]) -> None:
+    names = [p.name for folder in built.values() for p in (folder / "assets").iterdir()]
+    assert len(names) == len(set(names)) == len(built)
+
+
+@pytest.mark.parametrize("example", FROST_EXAMPLES)
+def test_every_asset_has_one_static_url(built: dict[str, Path], example: str) -> None:
+    """Bundlers follow a string-literal URL resolved against import.meta.url; a template literal or a
+    variable in its place is what broke Vite's dependency optimiser."""
+    folder = built[example]
+    sources = {name: content.decode() for name, content in tree(folder).items() if name.endswith(".js")}
+    referenced = []
+    for name, text in sources.items():
+        assert DYNAMIC_URL.search(text) is None or name == "tsl/assets.js", f"{name} builds a URL dynamically"
+        referenced += [m.group(2) for m in STATIC_ASSET_URL.finditer(text)]
+    assert sorted(referenced) == sorted(p.name for p in (folder / "assets").iterdir())
+
+
+def test_url_patterns_catch_variants() -> None:
+    assert STATIC_ASSET_URL.search("new URL('../assets/a-structure-0123456789ab.bin', import.meta.url)")
+    assert STATIC_ASSET_URL.search('new URL( "../assets/x.bin" ,import.meta.url )')
+    for dynamic in ("new URL(`../assets/${name}`, import.meta.url)", "new URL(name, import.meta.url)"):
+        assert STATIC_ASSET_URL.search(dynamic) is None
+        assert DYNAMIC_URL.search(dynamic)
+    assert DYNAMIC_URL.search("new URL('../assets/x.bin', import.meta.url)") is None
+
+
+#: Markdown links and images: [text](target) and ![alt](target).
+MARKDOWN_LINK = re.compile(r"!?\[[^\]]*\]\(([^)\s]+)\)")
+#: Package paths the README names in code spans, e.g. `examples/minimal.js` or `assets/<file>`.
+PACKAGE_PATH = re.compile(r"`((?:assets|examples|core|tsl)/[^`\s]+)`")
+
+
+@pytest.mark.parametrize("example", FROST_EXAMPLES)
+def test_readme_links_and_paths_are_published(built: dict[str, Path], example: str) -> None:
+    folder = built[example]
+    readme = (folder / "README.md").read_text()
+    published = {str(f["path"]) for f in npm_pack(folder)["files"]}
+    targets = [
+        t for t in MARKDOWN_LINK.findall(readme) if not re.match(r"^[a-z]+:", t) and not t.startswith("#")
+    ]
+    targets += PACKAGE_PATH.findall(readme)
+    assert any(t.startswith("examples/") for t in targets)
+    for target in targets:
+        path = PurePosixPath(target.split("#", 1)[0])
+        assert str(path) in published, f"README points at {target}, which npm pack does not publish"
+
+
+def test_link_patterns_catch_variants() -> None:
+    text = "![final](parity/final.png) see [the guide](docs/a.md) and [site](https://x.y) `assets/z.bin`"
+    assert MARKDOWN_LINK.findall(text) == ["parity/final.png", "docs/a.md", "https://x.y"]
+    assert PACKAGE_PATH.findall(text) == ["assets/z.bin"]
+
+
+@pytest.mark.parametrize("example", FROST_EXAMPLES)
+def test_readme_snippet_is_the_shipped_example(built: dict[str, Path], example: str) -> None:
+    """The README's page script is examples/minimal.js byte for byte (minus its generated-code header),
+    so type-checking and running that file checks the README."""
+    folder = built[example]
+    readme = (folder / "README.md").read_text()
+    blocks = re.findall(r"```js\n(.*?)```", readme, flags=re.DOTALL)
+    shipped = (folder / "examples" / "minimal.js").read_text()
+    header, body = shipped.split("\n", 1)
+    assert header.startswith("// Code generated by creaturegen ")
+    assert blocks[0] == body
+    imports = re.findall(r"""^import .* from (['"])([^'"]+)\1;$""", body, flags=re.MULTILINE)
+    assert {source for _, source in imports} == {"three/webgpu", folder.name}
+    for needed in (
+        "new THREE.WebGPURenderer",
+        "setPixelRatio",
+        "setSize",
+        "appendChild",
+        "await renderer.init()",
+        "setAnimationLoop",
+        "addEventListener('resize'",
+        "addEventListener('pointermove'",
+        "frost.resize(",
+        "frost.pointer(",
+        "frost.update(",
+        "frost.render()",
+    ):
+        assert needed in body, needed
 
 
 @pytest.mark.parametrize("example", FROST_EXAMPLES)
@@ -100,14 +256,14 @@ def test_generated_headers(built: dict[str, Path], example: str) -> None:
         elif name.endswith(".md"):
             assert text_start.startswith(b"<!-- Code generated by creaturegen "), name
             checked += 1
-    assert checked >= 9
+    assert checked >= 15
 
 
 @pytest.mark.parametrize("example", FROST_EXAMPLES)
 def test_shipped_js_hygiene(built: dict[str, Path], example: str) -> None:
     folder = built[example]
     sources = {name: content.decode() for name, content in tree(folder).items() if name.endswith(".js")}
-    assert len(sources) >= 7
+    assert len(sources) >= 11
     for name, text in sources.items():
         match = NONDETERMINISM.search(text)
         assert match is None, f"{name}: {match.group(0) if match else ''}"

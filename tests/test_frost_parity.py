@@ -41,6 +41,8 @@ def test_frost_package_passes_every_parity_gate(built: dict[str, Path], example:
     assert {
         "GPU vs numpy history at 30 FPS",
         "GPU vs numpy history at 120 FPS",
+        "GPU structure texels vs numpy decode of the shipped file",
+        "GPU normals texels vs numpy decode of the shipped file",
         "GPU validation errors",
     } <= names
     assert (package / "parity" / "final.png").stat().st_size > 1000
@@ -63,3 +65,21 @@ def test_parity_job_catches_a_wrong_gpu_decay_rate(built: dict[str, Path], tmp_p
     result = run_frost_parity(broken, groups=("history",))
     failed = [g["name"] for g in result.gates if g["status"] == "fail"]
     assert any(name.startswith("GPU vs numpy history") for name in failed), result.summary()
+
+
+@pytest.mark.browser
+def test_parity_job_catches_a_wrong_normal_derivation(built: dict[str, Path], tmp_path: Path) -> None:
+    # The runtime derives the normal map from the shipped heights; one changed constant in its arithmetic
+    # (the +1 under the square root) must show up as GPU normal texels that differ from numpy's decode.
+    source = built["frost-budgeted"]
+    broken = tmp_path / source.name
+    shutil.copytree(source, broken)
+    decoder = broken / "core" / "structure-file.js"
+    text = decoder.read_text()
+    exact = "Math.sqrt(nx * nx + ny * ny + 1.0)"
+    assert exact in text
+    decoder.write_text(text.replace(exact, "Math.sqrt(nx * nx + ny * ny + 1.01)"))
+    result = run_frost_parity(broken, groups=("structure",))
+    status = {g["name"]: g["status"] for g in result.gates}
+    assert status["GPU normals texels vs numpy decode of the shipped file"] == "fail", result.summary()
+    assert status["GPU structure texels vs numpy decode of the shipped file"] == "pass", result.summary()

@@ -15,7 +15,9 @@ from creaturegen.rig import compile_rig
 from creaturegen.spec import CharacterSpec, FrostEffectSpec, SpecValidationError, validate_bytes
 from creaturegen.spec.colors import CSS_NAMED_COLORS
 
-THREE_COLOR_JS = REPO / "web_lab" / "node_modules" / "three" / "src" / "math" / "Color.js"
+THREE_COLOR_JS = (
+    REPO / "generator" / "creaturegen" / "web_lab" / "node_modules" / "three" / "src" / "math" / "Color.js"
+)
 
 
 def _creature(color: object) -> dict[str, Any]:

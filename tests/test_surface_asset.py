@@ -32,7 +32,18 @@ from creaturegen.surface.asset import (
 )
 
 CHECK_GLB = REPO / "tools" / "check-glb.mjs"
-THREE = REPO / "web_lab" / "node_modules" / "three" / "examples" / "jsm" / "loaders" / "GLTFLoader.js"
+THREE = (
+    REPO
+    / "generator"
+    / "creaturegen"
+    / "web_lab"
+    / "node_modules"
+    / "three"
+    / "examples"
+    / "jsm"
+    / "loaders"
+    / "GLTFLoader.js"
+)
 EXTRAS: dict[str, object] = {"signatures": {"compilerSignature": "ab" * 32}, "tier": "full", "pi": 3.25}
 
 

@@ -16,6 +16,7 @@ import numpy as np
 import pytest
 
 from conftest import CREATURE_EXAMPLES, EXAMPLES, REPO, rest_surface, run_cli
+from creaturegen.creature.assets import surface_path
 from creaturegen.rig import compile_rig
 from creaturegen.spec import CharacterSpec, load_spec
 from creaturegen.surface import build as surface_build
@@ -144,7 +145,7 @@ def test_cli_build_is_byte_identical_across_backends_and_caches(tmp_path: Path) 
             assert "cache hit" in result.stdout + result.stderr
         digests.append(_package_digest(tmp_path / f"out-{n}" / "hopper-squash-core"))
     assert digests[0] == digests[1] == digests[2]
-    glb = (tmp_path / "out-0" / "hopper-squash-core" / "assets" / "surface.glb").read_bytes()
+    glb = surface_path(tmp_path / "out-0" / "hopper-squash-core").read_bytes()
     assert parse_glb(glb).positions.shape[1] == 3
 
 

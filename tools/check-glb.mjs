@@ -1,4 +1,4 @@
-// Load a .glb with three.js's own GLTFLoader (web_lab/node_modules, r185) in Node and print what it saw
+// Load a .glb with three.js's own GLTFLoader (generator/creaturegen/web_lab/node_modules, r185) in Node and print what it saw
 // as JSON: the creaturegen surface asset's round trip through the loader a viewer would use.
 //
 //   node tools/check-glb.mjs surface.glb [--values]
@@ -7,7 +7,7 @@
 // output instead of going to stderr.
 import { readFileSync } from 'node:fs';
 
-const here = new URL('../web_lab/node_modules/three/examples/jsm/loaders/GLTFLoader.js', import.meta.url);
+const here = new URL('../generator/creaturegen/web_lab/node_modules/three/examples/jsm/loaders/GLTFLoader.js', import.meta.url);
 const { GLTFLoader } = await import(here.href);
 
 const [file, ...flags] = process.argv.slice(2);

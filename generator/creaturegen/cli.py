@@ -137,6 +137,7 @@ def _build(args: argparse.Namespace) -> int:
         print(f"  gate {gate['name']}: {gate['value']:.3g} (threshold {gate['threshold']:.3g}) {verdict}")
     print(f"  history format {report['historyFormat']['historyFormat']}")
     print(f"wrote {folder}/")
+    _report_pack_size(folder)
     return EXIT_OK
 
 
@@ -272,7 +273,15 @@ def _build_creature(args: argparse.Namespace, spec: CharacterSpec, data: bytes) 
             return EXIT_GATE_FAILED
         digest = one.build.signatures["geometryDigest"]
         print(f"wrote {folder}/ (geometryDigest {digest[:12]})")
+        _report_pack_size(folder)
     return EXIT_OK
+
+
+def _report_pack_size(folder: Path) -> None:
+    from .emit.packsize import npm_pack_size
+
+    size = npm_pack_size(folder)
+    print(f"  {size if isinstance(size, str) else size.line()}")
 
 
 def _compiled(name: str) -> tuple[CharacterSpec, CompiledRig] | None:
@@ -374,7 +383,24 @@ def _inspect(args: argparse.Namespace) -> int:
     return EXIT_OK
 
 
+def _lab_missing() -> str | None:
+    """Why the lab cannot run from this install (Playwright absent, three not installable), else None."""
+    from .resources import MissingResourceError, lab_modules, playwright_missing
+
+    missing = playwright_missing()
+    if missing is None:
+        try:
+            lab_modules(install=True)
+        except MissingResourceError as exc:
+            missing = str(exc)
+    return missing
+
+
 def _parity(args: argparse.Namespace) -> int:
+    missing = _lab_missing()
+    if missing is not None:
+        print(f"creaturegen parity: {missing}", file=sys.stderr)
+        return EXIT_INVALID
     # Imported here: Playwright is only needed by this command, not by validate/build.
     from .lab.frost_parity import run_frost_parity
 
@@ -426,6 +452,13 @@ def _random(args: argparse.Namespace) -> int:
 
 
 def _lab(args: argparse.Namespace) -> int:
+    from .resources import MissingResourceError, lab_modules
+
+    try:
+        lab_modules(install=True)
+    except MissingResourceError as exc:
+        print(f"creaturegen lab: {exc}", file=sys.stderr)
+        return EXIT_INVALID
     from .lab import server
 
     argv = ["--root", str(server.WEB_LAB), "--out", args.out, "--host", args.host, "--port", str(args.port)]
@@ -545,8 +578,14 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def main(argv: Sequence[str] | None = None) -> int:
+    from .resources import MissingResourceError
+
     args = build_parser().parse_args(argv)
-    code: int = args.run(args)
+    try:
+        code: int = args.run(args)
+    except MissingResourceError as exc:  # a broken install: say what is missing, write nothing
+        print(f"creaturegen: {exc}", file=sys.stderr)
+        return EXIT_INVALID
     return code
 
 

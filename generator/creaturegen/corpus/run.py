@@ -51,12 +51,10 @@ def compiler_digest() -> str:
     """sha256 over the compiler's Python source and templates: what a build's outcome depends on (wider
     than surface/identity.py source_digest, which keys the surface cache by the surface's own packages)."""
     h = hashlib.sha256(__version__.encode())
-    roots = [PACKAGE_ROOT]
-    templates = PACKAGE_ROOT.parent.parent / "templates"
-    if templates.is_dir():
-        roots.append(templates)
-    for root in roots:
-        for path in sorted(p for p in root.rglob("*") if p.is_file() and "__pycache__" not in p.parts):
+    for root in [PACKAGE_ROOT]:  # the templates ship inside it
+        for path in sorted(
+            p for p in root.rglob("*") if p.is_file() and not {"__pycache__", "node_modules"} & set(p.parts)
+        ):
             h.update(str(path.relative_to(root)).encode())
             h.update(path.read_bytes())
     return h.hexdigest()
@@ -159,13 +157,16 @@ def run_job(job: Job, packages: Path, timeout: float = BUILD_TIMEOUT_S, workers:
 
 def _picture(record: dict[str, Any], spec_path: Path, pictures: Path) -> str | None:
     """Gallery thumbnail of a built hero package (None when it cannot be drawn)."""
+    from ..creature.assets import surface_path
     from ..rig import compile_rig
     from ..spec import CharacterSpec, load_spec
     from .preview import write_preview
 
-    package = Path(record.get("package", ""))
-    glb = package / "assets" / "surface.glb"
-    if not glb.is_file():
+    if not record.get("package"):
+        return None
+    try:
+        glb = surface_path(Path(record["package"]))
+    except (FileNotFoundError, ValueError):
         return None
     spec = load_spec(spec_path)
     assert isinstance(spec, CharacterSpec)

@@ -13,6 +13,7 @@ from ..spec import CharacterSpec, slugify
 from ..surface.asset import glb_bytes, sidecar_bytes
 from ..surface.build import SurfaceBuild
 from ..surface.emit import stable_sidecar
+from .assets import REPORT_PATH, SIDECAR_PATH, SPEC_PATH, shipped_files, shipped_spec
 from .picture import PICTURE_PATH, render_picture
 from .plan import build_plan
 
@@ -32,6 +33,8 @@ def build_report(plan: dict[str, Any], surface: SurfaceBuild) -> dict[str, Any]:
         "debugModes": plan["runtime"]["debugModes"],
         "candidateNote": plan["runtime"]["candidateNote"],
         "surface": {"passed": surface.passed, "counts": surface.sidecar.get("counts")},
+        # Where the package's files are: Python tools read the asset path here (creature/assets.py).
+        "assets": {"surface": plan["assets"]["surfacePath"], "spec": SPEC_PATH, "sidecar": SIDECAR_PATH},
         "gates": plan["gates"],
     }
 
@@ -42,14 +45,17 @@ def creature_files(
     """Every file of the package but the picture; with ``picture`` the README shows PICTURE_PATH."""
     spec_sha256 = hashlib.sha256(spec_bytes).hexdigest()
     built = build_plan(spec, rig, surface, spec_sha256)
-    plan = {**built.plan, "picture": PICTURE_PATH if picture else None}
+    shown = PICTURE_PATH if picture else None
+    files_list = shipped_files(built.plan["assets"]["surfacePath"], shown)
+    plan = {**built.plan, "picture": shown, "files": files_list}
     files = render_folder("creature", plan, spec_sha256)
-    # The exact spec bytes: the parity job rebuilds the Python reference (rig, field, skeleton) from them.
-    files.append(PackageFile("assets/spec.json", spec_bytes))
-    files.append(PackageFile("assets/surface.glb", glb_bytes(surface.asset, name=str(plan["slug"]))))
+    # The spec (minus an unresolvable $schema): the parity job rebuilds the Python reference from it.
+    files.append(PackageFile(SPEC_PATH, shipped_spec(spec_bytes)))
+    glb = glb_bytes(surface.asset, name=str(plan["slug"]))
+    files.append(PackageFile(str(plan["assets"]["surfacePath"]), glb))
     sidecar = {"//": header_text(spec_sha256), **stable_sidecar(surface.sidecar)}
-    files.append(PackageFile("assets/surface.json", sidecar_bytes(sidecar)))
-    files.append(PackageFile("build-report.json", (to_json(build_report(plan, surface)) + "\n").encode()))
+    files.append(PackageFile(SIDECAR_PATH, sidecar_bytes(sidecar)))
+    files.append(PackageFile(REPORT_PATH, (to_json(build_report(plan, surface)) + "\n").encode()))
     return files
 
 

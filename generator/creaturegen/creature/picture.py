@@ -1,7 +1,7 @@
 """The package README's picture: the built package rendered by the creature lab (headless Chromium,
 WebGPU on SwiftShader) and read back from a render target, before the package folder is committed.
 
-It is part of the build, so a build with the picture needs the lab (Chromium and web_lab/node_modules).
+It is part of the build, so a build with the picture needs the lab (Chromium, Playwright and three from npm).
 ``picture_unavailable`` says why it cannot run here, so ``--picture auto`` can build without it and say so.
 """
 
@@ -24,14 +24,17 @@ PICTURE_SEED = 1
 
 def picture_unavailable() -> str | None:
     """None when the lab can render here, else the reason it cannot."""
-    from ..lab.browser import find_chromium
-    from ..lab.server import WEB_LAB
+    from ..resources import MissingResourceError, lab_modules, playwright_missing
 
-    if not (WEB_LAB / "node_modules" / "three" / "package.json").is_file():
-        return f"{WEB_LAB}/node_modules has no three (run `make setup` or `npm ci` in web_lab/)"
+    missing = playwright_missing()
+    if missing is not None:
+        return missing
+    from ..lab.browser import find_chromium
+
     try:
+        lab_modules(install=True)
         find_chromium()
-    except RuntimeError as exc:
+    except (RuntimeError, MissingResourceError) as exc:
         return str(exc)
     return None
 

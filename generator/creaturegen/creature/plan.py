@@ -25,6 +25,7 @@ from ..surface import correct as correction
 from ..surface.build import NO_PROGRAM, SurfaceBuild
 from ..surface.deform import METHODS
 from ..surface.skeleton import Skeleton, build_skeleton
+from .assets import asset_plan
 from .genome import genetics_data, slot_lab
 from .pose import LCG_A, LCG_C, POSE_ROWS
 from .tape import Tape, compile_tape
@@ -33,6 +34,9 @@ from .tape import Tape, compile_tape
 DEBUG_MODES = ("off", "skin-only", "distance", "weights", "normals", "candidates", "shell")
 #: vec4 per vertex in a page's deform storage (templates/creature/tsl/deform.js DEFORM_STRIDE).
 DEFORM_STRIDE = 3
+#: The three.js release the templates are written against: TSL names and node semantics move between
+#: releases, so the package pins its peer to it and refuses another REVISION at run time.
+THREE_RELEASE = {"revision": "185", "peer": ">=0.185.0 <0.186.0", "pin": "0.185", "types": "0.185"}
 
 
 @dataclass(frozen=True)
@@ -82,13 +86,18 @@ def build_plan(
     floors = floors_for(rig.body_scale)
     asset = surface.asset
     skin = np.asarray(asset.skin)  # (V, 2): method code, trust radius
+    slug = slugify(spec.name)
+    assets = asset_plan(slug, surface.signatures["geometryDigest"])
     runtime: dict[str, Any] = {
         "name": spec.name,
-        "slug": slugify(spec.name),
+        "slug": slug,
         "version": __version__,
         "specSha256": spec_sha256,
         "signatures": dict(surface.signatures),
         "tier": surface.tier,
+        # The runtime names its .glb in errors and resolves it against `assetBase`.
+        "surfaceFile": assets["surfaceFile"],
+        "threeRevision": THREE_RELEASE["revision"],
         "bodyScale": rig.body_scale,
         "slotCount": rig.slot_count,
         # One extra "part" per instance: the root rows (position + alive, yaw cos/sin + squash + size).
@@ -122,9 +131,11 @@ def build_plan(
         "deformStride": DEFORM_STRIDE,
     }
     swims = motion["type"] == "swimmer"
-    # The README's usage snippet: a swimmer needs a water provider (the template only prints these).
+    # The README's minimal page (examples/minimal.js): a swimmer needs a water provider (the template
+    # only prints these).
+    water = ["createAnalyticWater"] if swims else []
     usage = {
-        "imports": "createCreaturePopulation, createAnalyticWater" if swims else "createCreaturePopulation",
+        "imports": ", ".join(["CREATURE", *water, "createCreaturePopulation"]),
         "options": "{ capacity: 64, water: createAnalyticWater() }" if swims else "{ capacity: 64 }",
         "water": " and `water` (required: this creature swims)" if swims else "",
     }
@@ -135,6 +146,8 @@ def build_plan(
         "version": __version__,
         "specSha256": spec_sha256,
         "runtime": runtime,
+        "assets": assets,
+        "three": THREE_RELEASE,
         "usage": usage,
         # The package README's gait-gene line (each gene scales its fields together).
         "genes": "; ".join(" with ".join(g) for g in motion["genes"]["fields"]) or "nothing (no locomotion)",

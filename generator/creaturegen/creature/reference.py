@@ -1,8 +1,8 @@
 """The Python side of the creature parity job: what the lab's GPU readbacks are compared against.
 
 Everything here is the float64 reference (field/sampler.py, surface/deform.py, motion/simulate.py),
-rebuilt from the package's own ``assets/spec.json`` and ``assets/surface.glb``; nothing is read from the
-package's JS or computed by the browser.
+rebuilt from the package's own ``assets/spec.json`` and surface .glb (creature/assets.py names it);
+nothing is read from the package's JS or computed by the browser.
 """
 
 from __future__ import annotations
@@ -26,6 +26,7 @@ from ..spec import CharacterSpec, validate_bytes
 from ..surface.asset import SurfaceAsset, read_glb
 from ..surface.deform import Pose, posed_slots, skin_cor, skin_dq, skin_lbs
 from ..surface.skeleton import build_skeleton
+from .assets import SPEC_PATH, surface_path
 from .genome import draw_genome, genetics_data, genome_colours, slot_lab
 from .pose import sized_graph, sized_slots
 
@@ -44,13 +45,13 @@ class PackageReference:
 
 
 def load_reference(package: Path) -> PackageReference:
-    spec_bytes = (package / "assets" / "spec.json").read_bytes()
-    spec = validate_bytes(spec_bytes, str(package / "assets" / "spec.json"))
+    spec_path = package / SPEC_PATH
+    spec = validate_bytes(spec_path.read_bytes(), str(spec_path))
     if not isinstance(spec, CharacterSpec):
-        raise ValueError(f"{package}: assets/spec.json is not a creature spec")
+        raise ValueError(f"{package}: {SPEC_PATH} is not a creature spec")
     rig = compile_rig(spec)
     motion = build_motion(spec, rig, build_skeleton(spec, rig))
-    return PackageReference(spec, rig, motion, read_glb(package / "assets" / "surface.glb"))
+    return PackageReference(spec, rig, motion, read_glb(surface_path(package)))
 
 
 def instance_motion(

@@ -12,9 +12,8 @@ from typing import Any
 
 import jinja2
 
+from ..resources import templates_dir
 from .writer import PackageFile, header_for
-
-TEMPLATES = Path(__file__).resolve().parents[3] / "templates"
 
 
 def to_json(value: Any, indent: int | None = 2) -> str:
@@ -37,7 +36,7 @@ def environment(folder: Path) -> jinja2.Environment:
 
 def render_folder(kind: str, plan: dict[str, Any], spec_sha256: str) -> list[PackageFile]:
     """Every file of ``templates/<kind>/`` rendered with ``plan``, each with its generated-code header."""
-    folder = TEMPLATES / kind
+    folder = templates_dir(kind)
     env = environment(folder)
     files = []
     for source in sorted(p for p in folder.rglob("*") if p.is_file()):

@@ -1,4 +1,8 @@
-"""Build a frost package: plan → templates + assets + build-report.json → out/<slug>/ (atomically)."""
+"""Build a frost package: plan → templates + assets + build-report.json → out/<slug>/ (atomically).
+
+build-report.json stays beside the package as build diagnostics; package.json's ``files`` leaves it out of
+what ``npm pack`` publishes.
+"""
 
 from __future__ import annotations
 
@@ -26,6 +30,7 @@ def build_report(plan: dict[str, Any]) -> dict[str, Any]:
         "params": plan["params"],
         "debugViews": plan["debugViews"],
         "structure": plan["structure"],
+        "assets": plan["assets"],
         "mainScreenPeriod": plan["refraction"]["mainScreenPeriod"],
         "gates": plan["gates"],
     }
@@ -36,7 +41,7 @@ def build_frost(spec: FrostEffectSpec, spec_bytes: bytes, out_root: Path) -> Pat
     spec_sha256 = hashlib.sha256(spec_bytes).hexdigest()
     built = build_plan(spec, spec_sha256)
     files = render_folder("frost", built.plan, spec_sha256)
-    files.append(PackageFile("assets/structure.bin", built.structure.structure.tobytes()))
-    files.append(PackageFile("assets/normals.bin", built.structure.normals.tobytes()))
+    structure_asset = f"assets/{built.plan['assets']['structure']['file']}"
+    files.append(PackageFile(structure_asset, built.structure_file.data))
     files.append(PackageFile("build-report.json", (to_json(build_report(built.plan)) + "\n").encode()))
     return write_package(out_root, str(built.plan["slug"]), files)

@@ -6,6 +6,7 @@ is driven by the same FrostParams, which is what makes the GPU-vs-numpy parity t
 
 from __future__ import annotations
 
+import hashlib
 from dataclasses import dataclass
 from typing import Any
 
@@ -19,6 +20,7 @@ from .brush import NOISE_SALT, pcg_hash
 from .formats import FormatGate, choose_format
 from .params import FrostParams, frost_params, scaled_size
 from .structure import StructureMaps, generate_structure
+from .structure_file import StructureFile, encode_structure
 
 #: Debug views of the seed, in the order of the composite's view uniform.
 DEBUG_VIEWS = (
@@ -65,6 +67,13 @@ REFERENCE_DRAWING_BUFFER = (1920, 1080)
 
 BYTES_PER_TEXEL = {"rgba16float": 8, "rgba32float": 16}
 
+#: The three.js release the runtime is written for: the peer dependency range and the REVISION it checks.
+THREE_REVISION = "185"
+THREE_RANGE = ">=0.185.0 <0.186.0"
+
+#: Hex digits of the content digest in asset file names: enough that two packages' files never share a name.
+ASSET_DIGEST_CHARS = 12
+
 
 @dataclass(frozen=True)
 class FrostBuild:
@@ -72,6 +81,7 @@ class FrostBuild:
 
     plan: dict[str, Any]
     structure: StructureMaps
+    structure_file: StructureFile
     params: FrostParams
     gates: list[FormatGate]
 
@@ -81,10 +91,21 @@ def noise_salts(seed: int) -> list[int]:
         return [int(pcg_hash(np.array([seed ^ salt], dtype=np.uint32))[0]) for salt in NOISE_SALT]
 
 
+def asset_file_name(slug: str, role: str, data: bytes, extension: str) -> str:
+    """``<slug>-<role>-<digest>.<ext>``: unique per package and per content, so bundlers that copy the
+    assets of several packages into one folder never overwrite one with another, and caches never serve
+    a stale file under a new build."""
+    digest = hashlib.sha256(data).hexdigest()[:ASSET_DIGEST_CHARS]
+    return f"{slug}-{role}-{digest}.{extension}"
+
+
 def build_plan(spec: FrostEffectSpec, spec_sha256: str) -> FrostBuild:
     params = frost_params(spec)
     history_format, gates = choose_format(params, spec.tier.historyFormat)
     structure = generate_structure(spec.structure)
+    structure_file = encode_structure(structure)
+    slug = slugify(spec.name)
+    structure_name = asset_file_name(slug, "structure", structure_file.data, "bin")
     tiers = {name: dict(values) for name, values in TIER_DEFAULTS.items()}
     tiers[spec.tier.name].update(historyScale=params.history_scale, blurScale=spec.tier.blurScale)
     width, height = REFERENCE_DRAWING_BUFFER
@@ -92,7 +113,7 @@ def build_plan(spec: FrostEffectSpec, spec_sha256: str) -> FrostBuild:
     texels = history_width * history_height
     plan: dict[str, Any] = {
         "name": spec.name,
-        "slug": slugify(spec.name),
+        "slug": slug,
         "version": __version__,
         "specSha256": spec_sha256,
         "params": params.as_plan(),
@@ -113,14 +134,18 @@ def build_plan(spec: FrostEffectSpec, spec_sha256: str) -> FrostBuild:
         "fades": spec.fades.model_dump(),
         "blur": {"sigma": BLUR_SIGMA, "epsilon": BLUR_EPSILON},
         "structure": {**spec.structure.model_dump(), "sha256": structure.sha256},
-        "assets": {"structure": "structure.bin", "normals": "normals.bin"},
+        "assets": {"structure": structure_file.layout(structure_name)},
+        "three": {"revision": THREE_REVISION, "range": THREE_RANGE},
         "noiseSalts": noise_salts(spec.seed),
         "debugViews": list(DEBUG_VIEWS),
         "memory": {
             "referenceDrawingBuffer": [width, height],
             "historyBytes": 2 * texels * BYTES_PER_TEXEL[history_format],
             "structureBytes": int(structure.structure.nbytes + structure.normals.nbytes),
+            "structureFileBytes": len(structure_file.data),
         },
         "gates": [gate.as_dict() for gate in gates],
     }
-    return FrostBuild(plan=plan, structure=structure, params=params, gates=gates)
+    return FrostBuild(
+        plan=plan, structure=structure, structure_file=structure_file, params=params, gates=gates
+    )

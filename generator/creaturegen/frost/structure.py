@@ -12,8 +12,15 @@ a three.js ``DataTexture`` with ``flipY = false`` uploads row 0 first, so WebGPU
 * ``structure``: R = crystal density ``S`` (1 = dense frost crystals), G = smooth low-frequency
   thickness (the height weight of the detail refraction), B = crystal height ``H`` (what the main
   normals are the slope of), A = 255.
-* ``normals``: RG = main-scale normal xy of ``H``, BA = detail-scale normal xy of a finer variant of
-  ``H``; both encoded ``0.5 + 0.5·n`` with ``n_z = sqrt(1 − n_x² − n_y²)`` implied.
+* ``normals``: RG = main-scale normal xy of ``H``, BA = detail-scale normal xy of ``D``, a finer height
+  (the crystal edges and the rime grain) that only the normals use; both encoded ``0.5 + 0.5·n`` with
+  ``n_z = sqrt(1 − n_x² − n_y²)`` implied.
+
+The normals are not shipped: they are a pure function of the 8-bit ``H`` and ``D`` (``derive_normals``), so
+a package ships ``S``, thickness, ``H`` and ``D`` (structure_file.py) and the runtime derives the normal map
+with the same float64 operations in the same order, which gives the same bytes (IEEE 754 rounds +, −, ×, ÷
+and √ correctly in numpy and in JavaScript alike). Deriving from the 8-bit heights rather than from the
+float heights costs about one normal code (RMS, measured) and halves what a package ships.
 
 The pattern is a jittered-grid Voronoi tessellation (one crystal per cell, ``crystalScale`` cells across)
 in which every crystal grows ``branches`` slightly curled dendrite arms from its nucleus, each arm
@@ -35,7 +42,15 @@ import numpy.typing as npt
 
 from creaturegen.spec.frost import Structure
 
-__all__ = ["REFERENCE_TEXELS", "StructureMaps", "generate_structure", "to_float"]
+__all__ = [
+    "REFERENCE_TEXELS",
+    "NormalScale",
+    "StructureMaps",
+    "derive_normals",
+    "generate_structure",
+    "normal_scales",
+    "to_float",
+]
 
 F32: TypeAlias = npt.NDArray[np.float32]
 F64: TypeAlias = npt.NDArray[np.float64]
@@ -51,6 +66,10 @@ REFERENCE_TEXELS = 256
 #: every resolution; the refraction spec's main/detail strengths then set the actual screen offsets.
 _MAIN_RELIEF = 5.0
 _DETAIL_RELIEF = 1.5
+#: Band limits (Gaussian sigma, in reference texels) of the main and the detail height: the main height
+#: keeps the broad crystal bodies, the detail height the crystal edges.
+_MAIN_BAND = 1.0
+_DETAIL_BAND = 0.5
 #: Most dendrite arms a spec admits (``Structure.branches`` ≤ 16); per-arm lengths are always drawn for
 #: all of them so that ``branches`` changes the pattern without shifting the random stream.
 _MAX_ARMS = 16
@@ -66,18 +85,40 @@ _THICKNESS_MIN_CELLS = 3.0
 _STRIP_TEXELS = 1 << 16
 
 
+@dataclass(frozen=True)
+class NormalScale:
+    """How one normal map follows from an 8-bit height plane (see ``derive_normals``).
+
+    ``spacing``: texels between a texel and each neighbour its slope is differenced with, half the height's
+    band limit: one texel differences of 8-bit heights are too coarse at high resolutions (the slope of a
+    2048 bake moves by a fraction of a height code per texel), wider ones smooth what the band kept.
+    ``scale``: normal xy per height code of difference, ``gain / (2 · 255 · spacing)``. Both reach the
+    runtime through the plan, so the JavaScript twin multiplies by exactly this double.
+    """
+
+    spacing: int
+    scale: float
+
+    def as_plan(self) -> dict[str, Any]:
+        return {"spacing": self.spacing, "scale": self.scale}
+
+
 @dataclass(frozen=True, eq=False)
 class StructureMaps:
     """The baked maps of one ``Structure`` spec; arrays are read-only so the hash stays true.
 
-    ``sha256`` is the hex digest of ``structure.tobytes() + normals.tobytes()``: packages that bake the
-    same spec share the texture files by content. It is exact for one numpy build on one CPU family;
-    vectorised transcendental functions may differ in the last ulp elsewhere, which can flip a rare
-    byte, so compare hashes of shipped files, not of bakes made on different machines.
+    ``detail`` is the 8-bit detail height ``D`` (N × N) the detail normals are derived from; ``main`` and
+    ``fine`` say how each normal map is derived. ``sha256`` is the hex digest of
+    ``structure.tobytes() + normals.tobytes()``, the texels the GPU samples. It is exact for one numpy
+    build on one CPU family; vectorised transcendental functions may differ in the last ulp elsewhere,
+    which can flip a rare byte, so compare hashes of shipped files, not of bakes made on different machines.
     """
 
     structure: U8
     normals: U8
+    detail: U8
+    main: NormalScale
+    fine: NormalScale
     resolution: int
     seed: int
     sha256: str
@@ -151,25 +192,88 @@ def generate_structure(structure: Structure) -> StructureMaps:
     # Both heights are band-limited in reference texels before they are differenced: the thinnest arms
     # are sub-texel at 256 and resolved at 2048, and without this the same spec would bake over twice as
     # steep normals at 2048 as at 256.
-    height = _normalise(0.75 * _blur(density, 1.0 * texel) + 0.25 * thickness)
+    height = _normalise(0.75 * _blur(density, _MAIN_BAND * texel) + 0.25 * thickness)
     # The detail map is tiled several times finer on screen, so it carries the crystal edges (the density
     # minus its local mean) and the rime grain rather than the broad crystal bodies.
-    edges = _blur(density, 0.5 * texel) - _blur(density, 0.08 * n / scale)
+    edges = _blur(density, _DETAIL_BAND * texel) - _blur(density, 0.08 * n / scale)
     detail = _normalise(edges + np.float32(0.35) * grain)
 
-    strength = float(structure.normalStrength)
     rgba = np.empty((n, n, 4), dtype=np.uint8)
     rgba[..., 0] = _quantise(density)
     rgba[..., 1] = _quantise(thickness)
     rgba[..., 2] = _quantise(height)
     rgba[..., 3] = 255
-    normals = np.empty((n, n, 4), dtype=np.uint8)
-    normals[..., 0:2] = _quantise(0.5 + 0.5 * _normal_xy(height, strength * _MAIN_RELIEF * texel))
-    normals[..., 2:4] = _quantise(0.5 + 0.5 * _normal_xy(detail, strength * _DETAIL_RELIEF * texel))
-    rgba.flags.writeable = False
-    normals.flags.writeable = False
+    detail8 = _quantise(detail)
+    main, fine = normal_scales(structure)
+    normals = derive_normals(rgba[..., 2], detail8, main, fine)
+    for array in (rgba, normals, detail8):
+        array.flags.writeable = False
     digest = hashlib.sha256(rgba.tobytes() + normals.tobytes()).hexdigest()
-    return StructureMaps(structure=rgba, normals=normals, resolution=n, seed=structure.seed, sha256=digest)
+    return StructureMaps(
+        structure=rgba,
+        normals=normals,
+        detail=detail8,
+        main=main,
+        fine=fine,
+        resolution=n,
+        seed=structure.seed,
+        sha256=digest,
+    )
+
+
+def normal_scales(structure: Structure) -> tuple[NormalScale, NormalScale]:
+    """The main and the detail ``NormalScale`` of a spec.
+
+    The gain is ``normalStrength`` times the relief times texels per reference texel, so slopes are per
+    reference texel and the relief is the same at every resolution.
+    """
+    n = structure.resolution
+    texel = n / REFERENCE_TEXELS
+    strength = float(structure.normalStrength)
+    scales = []
+    for relief, band in ((_MAIN_RELIEF, _MAIN_BAND), (_DETAIL_RELIEF, _DETAIL_BAND)):
+        spacing = max(1, int(band * texel / 2.0))
+        gain = strength * relief * texel
+        scales.append(NormalScale(spacing=spacing, scale=gain / (510.0 * spacing)))
+    return scales[0], scales[1]
+
+
+def derive_normals(height: U8, detail: U8, main: NormalScale, fine: NormalScale) -> U8:
+    """The normal map (N × N × 4: main xy of ``height``, detail xy of ``detail``) of two 8-bit heights.
+
+    Shipped packages run the same arithmetic in core/structure-file.js; both sides must perform the same
+    float64 operations in the same order (each one rounded, no fused multiply-add), so do not reorder,
+    regroup or vectorise differently here without changing the JavaScript in the same commit.
+    """
+    out = np.empty((*height.shape, 4), dtype=np.uint8)
+    out[..., 0:2] = _normal_codes(height, main)
+    out[..., 2:4] = _normal_codes(detail, fine)
+    return out
+
+
+def _normal_codes(height: U8, how: NormalScale) -> U8:
+    """Encoded normal xy of the surface ``z = gain · height``: ``0.5 + 0.5·n``, rounded half up to 8 bits.
+
+    The slope is a central difference over ``how.spacing`` texels, the grid mirrored about its border
+    texels. Why ``mode="reflect"`` (whole-sample mirror, ``h[−k] = h[k]``) and not ``"symmetric"``
+    (``h[−1] = h[0]``, the texels MirroredRepeatWrapping samples beyond the border): the normal map is
+    itself sampled mirrored, and a mirrored normal map cannot flip the sign of its x (or y) component the
+    way the mirrored surface's true normal does, so it meets its mirror image without a seam only where that
+    component is zero. The whole-sample mirror makes the border columns' ``∂h/∂u`` and the border rows'
+    ``∂h/∂v`` exactly zero (encoded 128). The price is a half-texel shift of the mirror axis, invisible here.
+    """
+    k = how.spacing
+    padded = np.pad(height.astype(np.float64), k, mode="reflect")
+    du = padded[k:-k, 2 * k :] - padded[k:-k, : -2 * k]
+    dv = padded[2 * k :, k:-k] - padded[: -2 * k, k:-k]
+    nx = -how.scale * du
+    ny = -how.scale * dv
+    inv = 1.0 / np.sqrt(nx * nx + ny * ny + 1.0)
+    codes = np.empty((*height.shape, 2), dtype=np.uint8)
+    # |n| < 1, so each code lands in [0, 255] without a clamp.
+    codes[..., 0] = np.floor((0.5 + 0.5 * (nx * inv)) * 255.0 + 0.5)
+    codes[..., 1] = np.floor((0.5 + 0.5 * (ny * inv)) * 255.0 + 0.5)
+    return codes
 
 
 def _crystals(n: int, scale: float, branches: int, sharpness: float, cells: _Cells) -> F32:
@@ -359,36 +463,6 @@ def _blur(field: F32, sigma: float) -> F32:
             rows[start : start + step] = strip
         out = np.ascontiguousarray(rows.T)
     return out
-
-
-def _gradient(height: F32) -> tuple[F32, F32]:
-    """Central differences of ``height`` per texel, the grid mirrored about its border texels.
-
-    Why ``mode="reflect"`` (whole-sample mirror, ``h[−1] = h[1]``) and not ``"symmetric"``
-    (``h[−1] = h[0]``, the texels MirroredRepeatWrapping samples beyond the border): the normal map is
-    itself sampled mirrored, and a mirrored normal map cannot flip the sign of its x (or y) component
-    the way the mirrored surface's true normal does, so it meets its mirror image without a seam only
-    where that component is zero. The whole-sample mirror makes the border columns' ``∂h/∂u`` and the
-    border rows' ``∂h/∂v`` exactly zero; the half-sample one would leave ``(h[1] − h[0]) / 2`` there.
-    The price is a half-texel shift of the mirror axis, invisible at these resolutions.
-    """
-    padded = np.pad(height, 1, mode="reflect")
-    du = (padded[1:-1, 2:] - padded[1:-1, :-2]) * np.float32(0.5)
-    dv = (padded[2:, 1:-1] - padded[:-2, 1:-1]) * np.float32(0.5)
-    return du.astype(np.float32), dv.astype(np.float32)
-
-
-def _normal_xy(height: F32, gain: float) -> F32:
-    """Normal xy of the surface ``z = gain · height``: normalise ``(−g·∂h/∂u, −g·∂h/∂v, 1)``.
-
-    ``gain`` is ``normalStrength`` times texels per reference texel, so slopes are per reference texel
-    and the relief is the same at every resolution; gain 0 gives exactly (0, 0), which encodes to 128.
-    """
-    du, dv = _gradient(height)
-    nx = np.float32(-gain) * du
-    ny = np.float32(-gain) * dv
-    inv = 1.0 / np.sqrt(nx * nx + ny * ny + np.float32(1.0))
-    return np.stack([nx * inv, ny * inv], axis=-1).astype(np.float32)
 
 
 def _normalise(field: F32) -> F32:

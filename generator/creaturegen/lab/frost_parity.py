@@ -13,13 +13,18 @@ the params the package was built with (build-report.json). Gates:
 - time policy: equal instants do nothing; a reversed interval runs the declared policy;
 - resize: the declared policy (clear → zeros; preserve-remap → the numpy bilinear remap of the GPU
   history read back just before);
+- structure texels: the structure and normal textures read back from the GPU (one textureLoad per texel)
+  equal, code for code, the numpy decode of the package's structure file (the runtime inflates it and
+  derives the normals in JavaScript; creaturegen.frost.structure_file does the same in numpy);
 - mirrored wrap: the structure view read back around a wrap line is symmetric and matches the numpy
-  mirrored-repeat bilinear sample of the shipped data; a plain-repeat prediction does not;
+  mirrored-repeat bilinear sample of the shipped data (the package's structure file, decoded by
+  creaturegen.frost.structure_file as the runtime decodes it); a plain-repeat prediction does not;
 - debug views: all of them render, switching creates no pipeline, no GPU validation error anywhere.
 """
 
 from __future__ import annotations
 
+import base64
 import dataclasses
 import json
 from collections.abc import Iterator
@@ -33,6 +38,7 @@ from ..frost.formats import HALF_FLOAT_TOLERANCE, replay
 from ..frost.params import FrostParams, params_from_plan
 from ..frost.path import FRAME_RATES, STROKE_SECONDS, STROKE_START, conformance_segments, frame_instants
 from ..frost.reference import STORAGE_OF_FORMAT, Storage, remap_bilinear
+from ..frost.structure_file import decode_structure_file
 from .browser import launch_lab_page
 from .frost_session import FrostLab
 from .png import write_png
@@ -176,10 +182,26 @@ def _resize_gate(lab: FrostLab, params: FrostParams, report: ParityReport, canva
     lab.call("([w, h]) => window.__lab.resize(w, h, 1)", list(canvas))
 
 
+def shipped_structure(package: Path) -> tuple[npt.NDArray[np.uint8], npt.NDArray[np.uint8]]:
+    """The structure and normal maps of a built package, decoded from its shipped structure file."""
+    layout = json.loads((package / "build-report.json").read_text())["assets"]["structure"]
+    return decode_structure_file((package / "assets" / layout["file"]).read_bytes(), layout)
+
+
+def _structure_gate(lab: FrostLab, package: Path, report: ParityReport) -> None:
+    structure, normals = shipped_structure(package)
+    raw = lab.call("() => window.__lab.readStructure()")
+    n = int(raw["resolution"])
+    for key, expected in (("structure", structure), ("normals", normals)):
+        gpu = np.frombuffer(base64.b64decode(raw[key]), dtype=np.uint8)
+        gpu = gpu.reshape(n, n, 4)
+        error = int(np.abs(gpu.astype(np.int16) - expected.astype(np.int16)).max())
+        report.gate(f"GPU {key} texels vs numpy decode of the shipped file", error, 0, "8-bit codes")
+
+
 def _mirror_gate(lab: FrostLab, package: Path, report: ParityReport, canvas: tuple[int, int]) -> None:
     plan = json.loads((package / "build-report.json").read_text())
-    n = int(plan["structure"]["resolution"])
-    data = np.frombuffer((package / "assets" / "structure.bin").read_bytes(), dtype=np.uint8).reshape(n, n, 4)
+    data, _ = shipped_structure(package)
     period = canvas[0] / 2
     lab.call("(p) => window.__lab.setControl('mainScreenPeriod', p)", period)
     shot = lab.capture("structure").astype(np.float64)
@@ -233,7 +255,7 @@ def _views_gate(lab: FrostLab, package: Path, report: ParityReport) -> None:
     report.measurements["debugViews"] = views
 
 
-GATE_GROUPS = ("history", "idle", "resize", "mirror", "views")
+GATE_GROUPS = ("history", "idle", "resize", "structure", "mirror", "views")
 
 
 def run_frost_parity(
@@ -253,6 +275,8 @@ def run_frost_parity(
             _idle_and_time_gates(lab, params, report)
         if "resize" in groups:
             _resize_gate(lab, params, report, canvas)
+        if "structure" in groups:
+            _structure_gate(lab, package, report)
         if "mirror" in groups:
             _mirror_gate(lab, package, report, canvas)
         if "views" in groups:

@@ -20,6 +20,8 @@ from collections.abc import Iterator, Sequence
 from pathlib import Path
 from typing import Any
 
+from ..resources import lab_modules, web_lab_dir
+
 #: Pinned so that a module script is never refused for a wrong type, whatever the host's tables say.
 MIME_TYPES: dict[str, str] = {
     ".html": "text/html; charset=utf-8",
@@ -40,8 +42,8 @@ MIME_TYPES: dict[str, str] = {
     ".ico": "image/x-icon",
 }
 
-#: The lab app: static pages beside the generator, with three from its own node_modules.
-WEB_LAB = Path(__file__).resolve().parents[3] / "web_lab"
+#: The lab app: static pages shipped inside the package (resources.py), three from resources.lab_modules.
+WEB_LAB = web_lab_dir()
 DEFAULT_HOST = "127.0.0.1"
 DEFAULT_PORT = 8765
 
@@ -99,7 +101,13 @@ def make_server(
     root = Path(root).resolve()
     if not root.is_dir():
         raise FileNotFoundError(f"lab server root {root} is not a directory")
-    handler = functools.partial(LabRequestHandler, directory=str(root), mounts=dict(mounts or {}))
+    mounted = dict(mounts or {})
+    if root == WEB_LAB.resolve() and "node_modules" not in mounted:
+        # The pages import /node_modules/three: a checkout's own, or the one an installed tool fetched.
+        modules = lab_modules(install=True)
+        if modules is not None:
+            mounted["node_modules"] = modules
+    handler = functools.partial(LabRequestHandler, directory=str(root), mounts=mounted)
     return _QuietThreadingServer((host, port), handler)
 
 
@@ -125,7 +133,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     """Entry point of ``make lab``: serve web_lab/ in the foreground until Ctrl-C."""
     parser = argparse.ArgumentParser(prog="python -m creaturegen.lab.server", description=__doc__)
     parser.add_argument(
-        "--root", type=Path, default=Path("web_lab"), help="folder to serve (default: web_lab)"
+        "--root", type=Path, default=WEB_LAB, help="folder to serve (default: the shipped web_lab)"
     )
     parser.add_argument("--host", default=DEFAULT_HOST, help=f"bind address (default: {DEFAULT_HOST})")
     parser.add_argument("--port", type=int, default=DEFAULT_PORT, help=f"port (default: {DEFAULT_PORT})")

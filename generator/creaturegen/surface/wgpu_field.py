@@ -26,8 +26,12 @@ rounds one intermediate no larger than the rig, so the gap stays at a few ulp of
 
 from __future__ import annotations
 
+import contextlib
 import importlib
-from collections.abc import Callable
+import os
+import sys
+import tempfile
+from collections.abc import Callable, Iterator
 from functools import cache
 from typing import Any
 
@@ -210,6 +214,30 @@ def slot_rows(slots: npt.NDArray[np.float64]) -> npt.NDArray[np.float32]:
     return rows.reshape(-1, 4)
 
 
+#: What Vulkan drivers print on a headless machine while enumerating adapters: noise to a user.
+_DRIVER_NOISE = ("XDG_RUNTIME_DIR is invalid or not set",)
+
+
+@contextlib.contextmanager
+def _quiet_driver() -> Iterator[None]:
+    """Hold back what native driver code writes to fd 2 during adapter discovery, passing on every line
+    but the known headless-machine noise (Python's own stderr is flushed first so nothing reorders)."""
+    sys.stderr.flush()
+    saved = os.dup(2)
+    with tempfile.TemporaryFile() as held:
+        os.dup2(held.fileno(), 2)
+        try:
+            yield
+        finally:
+            os.dup2(saved, 2)
+            os.close(saved)
+            held.seek(0)
+            lines = held.read().decode("utf-8", "replace").splitlines()
+            for line in lines:
+                if not any(n in line for n in _DRIVER_NOISE):
+                    print(line, file=sys.stderr)
+
+
 @cache
 def _device() -> Any:
     """One wgpu device per process (adapter discovery is slow and the device is stateless here)."""
@@ -218,7 +246,8 @@ def _device() -> Any:
     except ImportError as exc:
         raise BackendUnavailableError(f"the wgpu backend needs wgpu-py (pip install wgpu): {exc}") from exc
     try:
-        adapter = wgpu.gpu.request_adapter_sync(power_preference="high-performance")
+        with _quiet_driver():
+            adapter = wgpu.gpu.request_adapter_sync(power_preference="high-performance")
     except Exception as exc:  # wgpu-native reports a missing adapter in several ways
         raise BackendUnavailableError(f"the wgpu backend found no WebGPU adapter: {exc}") from exc
     if adapter is None:

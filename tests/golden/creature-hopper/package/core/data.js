@@ -2844,7 +2844,7 @@ export const CREATURE = Object.freeze({
     0
   ],
   "signatures": {
-    "compilerSignature": "2efa5d0ca28e88572b0d4e9fd698bb78fdc45fc8dacc8db039f42f51c3e6cc88",
+    "compilerSignature": "07e2f29b22ddc4b0b748b1c36041075debeb619e050c14daafde18a19bb9cc78",
     "geometryDigest": "400b0d18a2a9f6bbbfe5b441f89767f552a4f3b4c45a368d1129d632e1d2f4f1",
     "topologySignature": "330d551e8c006f84b01459c84db69ca8c43aec5bc9d9083d3e85c291be5a68bf"
   },
@@ -2997,6 +2997,8 @@ export const CREATURE = Object.freeze({
   ],
   "slug": "hopper-squash-core",
   "specSha256": "39d5b3741d62276f4e797100bd0fa23f513ce7cbb7855715504f81a6f0f7a1f5",
+  "surfaceFile": "hopper-squash-core-400b0d18a2a9.glb",
+  "threeRevision": "185",
   "tickRate": 60,
   "tier": "hero",
   "tiny": 1.1754943508222875e-38,

@@ -6,10 +6,11 @@
 const COMPONENTS = { 5123: Uint16Array, 5125: Uint32Array, 5126: Float32Array };
 const SIZES = { SCALAR: 1, VEC2: 2, VEC3: 3, VEC4: 4, MAT4: 16 };
 
-export function parseGlb(buffer) {
+/** `source` names the file in errors (a server answering a missing file with an HTML page is common). */
+export function parseGlb(buffer, source = 'surface') {
   const view = new DataView(buffer);
-  if (view.getUint32(0, true) !== 0x46546c67 || view.getUint32(4, true) !== 2) {
-    throw new Error('surface.glb: not a glTF 2.0 binary');
+  if (buffer.byteLength < 20 || view.getUint32(0, true) !== 0x46546c67 || view.getUint32(4, true) !== 2) {
+    throw new Error(`${source}: not a glTF 2.0 binary`);
   }
   const jsonLength = view.getUint32(12, true);
   const doc = JSON.parse(new TextDecoder().decode(new Uint8Array(buffer, 20, jsonLength)));

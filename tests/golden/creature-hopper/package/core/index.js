@@ -9,6 +9,11 @@ export {
 export { rootBounds, rotate, writePoseRows, writeRootRows } from './pose.js';
 export { hashBytes } from './hash.js';
 export { parseGlb } from './glb.js';
+// The surface loader's checks: the .glb's signatures and three's REVISION, each with a named error.
+export {
+  SURFACE_KEYS, SurfaceMismatchError, ThreeRevisionError, checkSurface, checkThreeRevision, expectedSurface, loadSurface,
+  resolveSurfaceUrl,
+} from './surface.js';
 // Locomotion: the fixed-step driver, providers (gravity, support surfaces, water) and the motion core.
 export { createDriver, MAX_FRAME_S, MAX_ACCUMULATOR_S } from './motion/driver.js';
 export {

@@ -9,5 +9,8 @@ export {
 } from './deform.js';
 export { DEBUG_MODES, checkDebugMode, createBodyMaterial, rootNormal, rootPoint, rootRotate } from './material.js';
 export { createShellMesh } from './shell.js';
-export { assertWebGPU, createCreaturePopulation, programStorage, surfaceGeometry } from './population.js';
+export {
+  assertThreeRevision, assertWebGPU, createCreaturePopulation, programStorage, surfaceGeometry,
+} from './population.js';
+export { SURFACE_FILE, defaultSurfaceUrl } from './asset.js';
 export { createDiagnostics } from './diagnostics.js';

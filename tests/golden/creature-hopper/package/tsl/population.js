@@ -8,13 +8,14 @@
 import * as THREE from 'three/webgpu';
 import { instancedArray } from 'three/tsl';
 import { CREATURE } from '../core/data.js';
-import { parseGlb } from '../core/glb.js';
 import { hashBytes } from '../core/hash.js';
 import { GENOME_LENGTH, drawGenome, genomeColours } from '../core/genome.js';
 import { createDriver } from '../core/motion/driver.js';
 import { assertWaterFor, createMotion } from '../core/motion/motion.js';
 import { createFlatGround, createGravity } from '../core/motion/providers.js';
 import { rootBounds, writePoseRows, writeRootRows } from '../core/pose.js';
+import { checkThreeRevision, loadSurface, resolveSurfaceUrl } from '../core/surface.js';
+import { defaultSurfaceUrl } from './asset.js';
 import { bodyFunctions, layoutOf } from './body.js';
 import {
   DEFORM_STRIDE, createDeformKernel, deformStorage, deformView, dispatchDeform, vertexRecords,
@@ -58,20 +59,21 @@ export function programStorage(data) {
   return instancedArray(new Float32Array(data.programData), 'vec4').toReadOnly();
 }
 
-async function loadSurface(url) {
-  const response = await fetch(url);
-  if (!response.ok) throw new Error(`${CREATURE.slug}: cannot load ${url} (${response.status})`);
-  return parseGlb(await response.arrayBuffer());
+/** Throws ThreeRevisionError unless the three.js in use is the release this package was built for. */
+export function assertThreeRevision(revision = THREE.REVISION) {
+  checkThreeRevision(revision);
 }
 
 /**
  * Create a population. Options: capacity (bodies, default 64), pageSize (bodies per page and draw,
  * at most what one storage binding of the device holds: DEFORM_STRIDE·16 bytes per vertex per body,
- * default 64), tier (the built tier only), debugMode, surfaceUrl (default: this package's asset),
- * support (a SupportSurfaceProvider, default flat ground at y = 0), gravity (a gravity provider, default
- * standard gravity), water (a WaterSurfaceProvider: required for a swimmer, which is refused without one).
+ * default 64), tier (the built tier only), debugMode, surfaceUrl (the .glb's URL) or assetBase (the
+ * folder holding CREATURE.surfaceFile; default: this package's own assets/), support (a
+ * SupportSurfaceProvider, default flat ground at y = 0), gravity (a gravity provider, default standard
+ * gravity), water (a WaterSurfaceProvider: required for a swimmer, which is refused without one).
  */
 export async function createCreaturePopulation(renderer, options = {}) {
+  assertThreeRevision();
   assertWebGPU(renderer);
   const data = CREATURE;
   const capacity = options.capacity ?? 64;
@@ -86,7 +88,7 @@ export async function createCreaturePopulation(renderer, options = {}) {
   assertWaterFor(data.motion.type, water, `${data.slug}: options.water`);
   const tier = options.tier ?? data.tier;
   if (tier !== data.tier) throw new Error(`tier: this package was built for tier ${data.tier} (got ${tier}); rebuild with --tier ${tier}`);
-  const surface = await loadSurface(options.surfaceUrl ?? new URL('../assets/surface.glb', import.meta.url).href);
+  const surface = await loadSurface(resolveSurfaceUrl(options, defaultSurfaceUrl));
   const geometry = surfaceGeometry(surface);
   const layout = layoutOf(data);
   const programs = programStorage(data);

@@ -1,0 +1,80 @@
+"""The files of a creature package beside its code: where each one lives and what exactly ships.
+
+The surface asset is named ``assets/<slug>-<geometryDigest[:12]>.glb`` because consumers merge assets:
+a bundler or a copy step that puts every package's ``assets/`` into one folder of a site must never let
+one creature's mesh stand in for another's (two packages that both shipped ``assets/surface.glb`` did
+exactly that: the quadruped silently drew the hopper's body). Python tools find the file through
+:func:`surface_path`, never by spelling the name, so the rule has one definition here.
+"""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+from typing import Any
+
+#: Folder of the package's data files, relative to the package root.
+ASSET_DIR = "assets"
+#: The spec the package was built from (the parity job rebuilds the Python reference from it).
+SPEC_PATH = f"{ASSET_DIR}/spec.json"
+#: The surface build's sidecar (gates, counts): a build diagnostic, kept beside the package, never shipped.
+SIDECAR_PATH = f"{ASSET_DIR}/surface.json"
+#: The build report: diagnostics beside the package, not part of what npm publishes.
+REPORT_PATH = "build-report.json"
+#: Hex digits of the geometryDigest in the asset's name: 48 bits, unique across any realistic site.
+DIGEST_DIGITS = 12
+
+
+def surface_file(slug: str, geometry_digest: str) -> str:
+    """The .glb's file name: the package slug and its geometry, so merged asset folders never collide."""
+    if len(geometry_digest) < DIGEST_DIGITS or not all(c in "0123456789abcdef" for c in geometry_digest):
+        raise ValueError(f"geometryDigest: expected lowercase hex, got {geometry_digest!r}")
+    return f"{slug}-{geometry_digest[:DIGEST_DIGITS]}.glb"
+
+
+def asset_plan(slug: str, geometry_digest: str) -> dict[str, str]:
+    """What templates print about the assets: the file name, its path in the package, and the URL
+    relative to a module one folder below the root (tsl/, core/), as the one static literal of the
+    ``new URL(..., import.meta.url)`` expression that asset-aware bundlers look for."""
+    name = surface_file(slug, geometry_digest)
+    return {"surfaceFile": name, "surfacePath": f"{ASSET_DIR}/{name}", "surfaceUrl": f"../{ASSET_DIR}/{name}"}
+
+
+#: The code and docs every package ships (package.json "files"; npm adds package.json and README.md).
+CODE_FILES = ("index.js", "index.d.ts", "core/", "tsl/", "examples/", "README.md")
+
+
+def shipped_files(surface: str, picture: str | None) -> list[str]:
+    """package.json ``files``: what runs and what the README shows, nothing else. The build report and
+    the surface sidecar are diagnostics of the build; they stay in the folder and are never published."""
+    return [*CODE_FILES, surface, SPEC_PATH, *([picture] if picture else [])]
+
+
+def surface_path(package: Path) -> Path:
+    """The surface .glb of a built package: named by its build report, or the one .glb of ``assets/``
+    when the report is absent (an installed copy, which ships no diagnostics)."""
+    report = package / REPORT_PATH
+    if report.is_file():
+        assets: Any = json.loads(report.read_text(encoding="utf-8")).get("assets", {})
+        relative = assets.get("surface") if isinstance(assets, dict) else None
+        if isinstance(relative, str):
+            named = package / relative
+            if not named.is_file():
+                raise FileNotFoundError(f"{package}: {REPORT_PATH} names a missing {relative}")
+            return named
+    found = sorted((package / ASSET_DIR).glob("*.glb"))
+    if len(found) != 1:
+        raise FileNotFoundError(f"{package}: expected one surface .glb in {ASSET_DIR}/, found {len(found)}")
+    return found[0]
+
+
+def shipped_spec(spec_bytes: bytes) -> bytes:
+    """The spec as the package ships it: the input bytes, unless the input names a ``$schema``. That
+    reference is relative to the author's checkout and resolves to nothing inside the package, so it is
+    dropped and the rest written back in the author's key order (the same spec: ``$schema`` is no input
+    to the compiler)."""
+    document = json.loads(spec_bytes)
+    if not isinstance(document, dict) or "$schema" not in document:
+        return spec_bytes
+    document.pop("$schema")
+    return (json.dumps(document, indent=2, ensure_ascii=False, allow_nan=False) + "\n").encode("utf-8")

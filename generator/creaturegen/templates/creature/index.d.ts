@@ -1,0 +1,117 @@
+// Types of the package entry: the pure-JS core (`./core`) and the population API of the three/TSL adapter
+// (also exported by `./tsl`). The three.js types come from @types/three, an optional peer dependency.
+import type { Camera, Group, Mesh, Object3D, WebGPURenderer } from 'three/webgpu';
+import type {
+  DebugMode, Driver, GravityProvider, Motion, SupportSurfaceProvider, TierName, WaterSurfaceProvider,
+} from './core/index.js';
+
+export * from './core/index.js';
+
+export interface PopulationOptions {
+  /** Bodies the population can hold; every page is allocated up front (default 64). */
+  capacity?: number;
+  /** Bodies per page: one material and one draw call each (default 64; clamped so that a page's deform
+   *  storage fits the device's maxStorageBufferBindingSize). */
+  pageSize?: number;
+  /** Must be the tier the package was built for. */
+  tier?: TierName;
+  debugMode?: DebugMode;
+  /** The surface .glb's own URL (e.g. what a bundler's file loader returned for
+   *  `<package>/assets/<CREATURE.surfaceFile>`). Default: the package's copy, `new URL(..., import.meta.url)`. */
+  surfaceUrl?: string | URL;
+  /** The folder the .glb was copied to (ending in '/'): it is fetched from `new URL(CREATURE.surfaceFile, assetBase)`;
+   *  a relative base resolves against the page. Give surfaceUrl or assetBase, not both. */
+  assetBase?: string | URL;
+  /** The ground every body walks on (default: flat ground at y = 0; see builtinSupports()). */
+  support?: SupportSurfaceProvider;
+  /** Gravity, never scaled by creature scale (default: 9.80665 m/s² down). */
+  gravity?: GravityProvider;
+  /** Required for a swimmer (refused with TierRefusedError without one, or with a missing channel). */
+  water?: WaterSurfaceProvider;
+}
+
+export interface SpawnOptions {
+  /** Unsigned 32-bit seed: the individual's genome (heading, colour, gait and size genes) from the package's LCG. */
+  seed?: number;
+  /** Where the body's path starts; the locomotion puts it on the support, the water or at its altitude. */
+  position?: [number, number, number];
+}
+
+export interface InstanceInfo {
+  alive: boolean;
+  seed: number;
+  /** Population tick at spawn: the body's own tick is the population's minus this. */
+  spawnTick: number;
+  /** The body's own tick (null when dead). */
+  tick: number | null;
+  /** x, y, z, cos yaw, sin yaw, squash (null when dead). */
+  root: number[] | null;
+  /** Posed world AABB: min xyz, max xyz. */
+  bounds: number[];
+  /** Genes in [-1, 1): hue, chroma, lightness, the gait genes, then size (null when dead). */
+  genome: number[] | null;
+}
+
+export interface CreaturePopulation {
+  readonly object3d: Group;
+  readonly tick: number;
+  readonly capacity: number;
+  /** Bodies per page: the requested pageSize clamped to what one storage binding of the device holds. */
+  readonly pageSize: number;
+  /** GPU bytes of deform storage per body (three vec4 per mesh vertex). */
+  readonly deformBytesPerBody: number;
+  readonly count: number;
+  readonly debugMode: DebugMode;
+  readonly stats: {
+    uploads: number; uploadBytes: number; lastFrameBytes: number; spawns: number; ticks: number;
+    /** Deform pre-pass dispatches so far, and the vertices the last flush deformed. */
+    deformDispatches: number; lastFrameDeformedVertices: number;
+  };
+  /** One pose page: its body mesh (one draw per pass) and, once debug mode 'shell' was shown, its shell. */
+  readonly pages: { mesh: Mesh; shell: Mesh | null }[];
+  /** Validation plus an O(slots) write; returns the instance id. Throws when full. */
+  spawn(options?: SpawnOptions): number;
+  despawn(id: number): void;
+  readonly support: SupportSurfaceProvider;
+  readonly gravity: GravityProvider;
+  readonly water: WaterSurfaceProvider | null;
+  /** The fixed-step driver update() uses. */
+  readonly driver: Driver;
+  /** Advance every body n fixed ticks (pose of the current step); returns the bytes uploaded. */
+  stepTicks(n?: number): number;
+  /** Every body re-simulated to tick n (same state as stepping there); returns the bytes uploaded. */
+  seekTick(n: number): number;
+  /** One render frame of dt seconds: the fixed steps due, then the interpolated render pose; returns steps. */
+  update(dt: number): number;
+  /** The locomotion core of a live instance, or null. */
+  motion(id: number): Motion | null;
+  /** Upload the dirty pose ranges left by spawn/despawn and run the deform pre-pass over them. */
+  flush(): number;
+  instance(id: number): InstanceInfo;
+  stagedPose(id: number): Float32Array;
+  stateHash(): string;
+  setDebugMode(mode: DebugMode): void;
+  setTier(tier: TierName): void;
+  variantKeys(): string[];
+  /** Build every shipped variant (deform compute, display, shadow) before the first visible frame. */
+  warm(scene: Object3D, camera: Camera): Promise<void>;
+  dispose(): void;
+}
+
+export interface CreatureDiagnostics {
+  readSkinned(id: number): Promise<{ skinned: Float32Array; corrected: Float32Array; accepted: Float32Array; gradient: Float32Array; distance: Float32Array }>;
+  probeField(id: number, xyz: Float32Array, program?: number): Promise<Float32Array>;
+  readPose(id: number): Promise<Float32Array>;
+  /** What the passes draw: the page's deform storage for instance `id` (creature-local). */
+  readDeformed(id: number): Promise<{ position: Float32Array; gradient: Float32Array; distance: Float32Array; accepted: Float32Array; colour: Float32Array; program: Float32Array }>;
+}
+
+export const DEBUG_MODES: readonly DebugMode[];
+/** Throws ThreeRevisionError unless `revision` (default: three's REVISION) is the release the package targets. */
+export function assertThreeRevision(revision?: string): void;
+/**
+ * Requires three r185 (else ThreeRevisionError) and an initialised WebGPURenderer on a WebGPU backend.
+ * Rejects with SurfaceMismatchError when the fetched .glb is not this package's surface.
+ */
+export function createCreaturePopulation(renderer: WebGPURenderer, options?: PopulationOptions): Promise<CreaturePopulation>;
+export function createDiagnostics(renderer: WebGPURenderer, population: CreaturePopulation, options?: { maxPoints?: number }): CreatureDiagnostics;

@@ -1,0 +1,89 @@
+// Types of the three/TSL adapter (`<package>/tsl`): the population API (declared by the package entry,
+// index.d.ts) and the node builders it is made of. Needs @types/three (an optional peer dependency).
+import type {
+  BufferGeometry, ComputeNode, Mesh, MeshStandardNodeMaterial, Node, StorageBufferNode, UniformNode, WebGPURenderer,
+} from 'three/webgpu';
+import type { CreatureData, DebugMode, ParsedSurface } from '../core/index.js';
+
+export type {
+  CreatureDiagnostics, CreaturePopulation, InstanceInfo, PopulationOptions, SpawnOptions,
+} from '../index.js';
+export { DEBUG_MODES, assertThreeRevision, createCreaturePopulation, createDiagnostics } from '../index.js';
+
+// --- the node builders the population is made of (used by the creaturegen lab; stable within a release) ---
+
+/** Layout constants every node graph of this creature shares (layoutOf(CREATURE)). */
+export interface Layout {
+  rows: number; maxParts: number; slotCount: number; registers: number; fullProgram: number; noProgram: number;
+  gradientFloor: number; tiny: number; kFloor: number; bodyScale: number;
+  correction: CreatureData['correction']; vertices: number;
+}
+export type PoseStorage = StorageBufferNode<'vec4'>;
+
+export const OP: Readonly<{ LEAF: 0; POLY: 1; COPY: 2; LSE: 3; MIN: 4 }>;
+/** The field nodes of one pose layout: per-slot distance, program evaluation (vec4: d, ∇d) and the size row. */
+export interface BodyField {
+  slotField(p: Node, base: Node, slot: Node): Node;
+  evaluate(p: Node, base: Node, program: Node, options?: { colour?: boolean; kFloor?: number }): { value: Node; colour: Node | null };
+  runProgram(p: Node, base: Node, program: Node): Node;
+  size(base: Node): Node;
+}
+export function createField(options: {
+  pose: PoseStorage; programs: PoseStorage; rows: number; slotCount: number; registers: number; gradientFloor: number; tiny: number;
+}): BodyField;
+export function rootSize(layout: { slotCount: number; rows: number }, pose: PoseStorage, base: Node): Node;
+
+export const METHOD: Readonly<{ LBS: 0; DQ: 1; COR: 2 }>;
+export interface BodySkin {
+  skinVertex(v: Node, base: Node, slots: Node, weights: Node, method: Node, centre: Node): Node;
+  correctVertex(p0: Node, base: Node, program: Node, trust: Node): { position: Node; accepted: Node };
+  lbs(v: Node, base: Node, slots: Node, weights: Node): Node;
+  dq(v: Node, base: Node, slots: Node, weights: Node): Node;
+  cor(v: Node, base: Node, slots: Node, weights: Node, centre: Node): Node;
+}
+export function createSkin(options: { pose: PoseStorage; rows: number; field: BodyField; correction: Layout['correction'] }): BodySkin;
+/** R(q)·v on nodes (q xyzw). */
+export function rotate(q: Node, v: Node): Node;
+
+export interface BodyFunctions { field: BodyField; skin: BodySkin }
+export interface VertexInputs { rest: Node; slots: Node; weights: Node; cor: Node; skin: Node }
+export interface BodyVertex {
+  skinned: Node; position: Node; accepted: Node; program: Node; gradient: Node; distance: Node; colour: Node | null;
+}
+export function layoutOf(data: CreatureData): Layout;
+export function bodyFunctions(layout: Layout, pose: PoseStorage, programs: PoseStorage): BodyFunctions;
+export function bodyVertex(layout: Layout, fns: BodyFunctions, inputs: VertexInputs & { base: Node; skinOnly: boolean; colour?: boolean }): BodyVertex;
+
+/** vec4 per drawn vertex in a page's deform storage (CREATURE.deformStride). */
+export const DEFORM_STRIDE: number;
+/** vec4 per rest vertex in the vertex records. */
+export const RECORD_STRIDE: number;
+export interface DeformKernel { kernel: ComputeNode; first: UniformNode<'int', number>; vertices: number; size: number }
+export function vertexRecords(geometry: BufferGeometry): PoseStorage;
+export function recordInputs(records: PoseStorage, v: Node): VertexInputs;
+export function deformStorage(size: number, vertices: number): PoseStorage;
+export function deformView(deform: PoseStorage): PoseStorage;
+export function createDeformKernel(layout: Layout, fns: BodyFunctions, options: {
+  pose: PoseStorage; records: PoseStorage; deform: PoseStorage; size: number; vertices: number; skinOnly?: boolean;
+}): DeformKernel;
+/** Run `deform` over instances lo..hi of its page (inclusive); returns the vertices processed. */
+export function dispatchDeform(renderer: WebGPURenderer, deform: DeformKernel, lo: number, hi: number): number;
+
+/** Throws unless `mode` is one of DEBUG_MODES; returns it. */
+export function checkDebugMode(mode: string): DebugMode;
+export function createBodyMaterial(layout: Layout, pose: PoseStorage, deform: PoseStorage, mode: DebugMode): MeshStandardNodeMaterial;
+export function rootRotate(root1: Node, v: Node): Node;
+export function rootPoint(root1: Node, p: Node): Node;
+export function rootNormal(root1: Node, n: Node): Node;
+export function createShellMesh(layout: Layout, pose: PoseStorage, name: string): Mesh;
+
+/** Throws unless `renderer` is an initialised WebGPURenderer on the WebGPU backend. */
+export function assertWebGPU(renderer: WebGPURenderer): void;
+/** The program tapes as one read-only vec4 storage node. */
+export function programStorage(data: CreatureData): PoseStorage;
+/** BufferGeometry of the parsed reference surface with the skinning attributes the material reads. */
+export function surfaceGeometry(surface: ParsedSurface): BufferGeometry;
+/** The .glb's file name in assets/ (CREATURE.surfaceFile). */
+export const SURFACE_FILE: string;
+/** The package's own copy of the surface: `new URL('../assets/<SURFACE_FILE>', import.meta.url)`, as a string. */
+export function defaultSurfaceUrl(): string;

@@ -1,0 +1,15 @@
+// Three/TSL adapter: pose pages, field programs, skinning, the deform pre-pass, materials, population,
+// the diagnostic shell, diagnostics.
+export { OP, createField, rootSize } from './field.js';
+export { METHOD, createSkin, rotate } from './skin.js';
+export { bodyFunctions, bodyVertex, layoutOf } from './body.js';
+export {
+  DEFORM_STRIDE, RECORD_STRIDE, createDeformKernel, deformStorage, deformView, dispatchDeform, recordInputs, vertexRecords,
+} from './deform.js';
+export { DEBUG_MODES, checkDebugMode, createBodyMaterial, rootNormal, rootPoint, rootRotate } from './material.js';
+export { createShellMesh } from './shell.js';
+export {
+  assertThreeRevision, assertWebGPU, createCreaturePopulation, programStorage, surfaceGeometry,
+} from './population.js';
+export { SURFACE_FILE, defaultSurfaceUrl } from './asset.js';
+export { createDiagnostics } from './diagnostics.js';

@@ -1,0 +1,429 @@
+// A population of one creature: fixed-capacity pose pages (vec4 storage, CPU Float32Array staging),
+// one deform pre-pass, one material and one draw per page, coalesced dirty-range uploads, posed bounds
+// per page. Every body is driven by its own locomotion core (core/motion/motion.js) on the population's
+// support, gravity and water providers; the pose rows are what that core computed. Nothing GPU-side is
+// created after warm(): pages, deform storage, materials and pipelines (compute, display, shadow) are
+// built and warmed up front; a spawn validates, builds the body's CPU motion state and writes O(slots).
+import * as THREE from 'three/webgpu';
+import { instancedArray } from 'three/tsl';
+import { CREATURE } from '../core/data.js';
+import { hashBytes } from '../core/hash.js';
+import { GENOME_LENGTH, drawGenome, genomeColours } from '../core/genome.js';
+import { createDriver } from '../core/motion/driver.js';
+import { assertWaterFor, createMotion } from '../core/motion/motion.js';
+import { createFlatGround, createGravity } from '../core/motion/providers.js';
+import { rootBounds, writePoseRows, writeRootRows } from '../core/pose.js';
+import { checkThreeRevision, loadSurface, resolveSurfaceUrl } from '../core/surface.js';
+import { defaultSurfaceUrl } from './asset.js';
+import { bodyFunctions, layoutOf } from './body.js';
+import {
+  DEFORM_STRIDE, createDeformKernel, deformStorage, deformView, dispatchDeform, vertexRecords,
+} from './deform.js';
+import { checkDebugMode, createBodyMaterial } from './material.js';
+import { createShellMesh } from './shell.js';
+
+const SHIPPED_VARIANTS = ['off'];
+
+/** Throw unless `renderer` is an initialised WebGPURenderer on the WebGPU backend. */
+export function assertWebGPU(renderer) {
+  if (!renderer || !renderer.backend || renderer.backend.isWebGPUBackend !== true) {
+    throw new Error(`${CREATURE.slug}: needs WebGPURenderer on a WebGPU backend (await renderer.init() first; `
+      + 'the WebGL2 fallback is not supported)');
+  }
+}
+
+/** BufferGeometry of the reference mesh with the skinning attributes this package's material reads. */
+export function surfaceGeometry(surface) {
+  const a = surface.attributes;
+  const geometry = new THREE.BufferGeometry();
+  geometry.setAttribute('position', new THREE.BufferAttribute(a.POSITION.array, 3));
+  geometry.setAttribute('normal', new THREE.BufferAttribute(a.NORMAL.array, 3));
+  geometry.setAttribute('cgSlots', new THREE.BufferAttribute(a._SLOTS.array, 4));
+  geometry.setAttribute('cgWeights', new THREE.BufferAttribute(a._WEIGHTS.array, 4));
+  geometry.setAttribute('cgCor', new THREE.BufferAttribute(a._COR.array, 3));
+  const n = a.POSITION.array.length / 3;
+  const skin = new Float32Array(4 * n);
+  for (let i = 0; i < n; i++) {
+    skin[4 * i] = a._SKIN.array[2 * i];
+    skin[4 * i + 1] = a._SKIN.array[2 * i + 1];
+    skin[4 * i + 2] = a._CANDIDATE.array[i];
+  }
+  geometry.setAttribute('cgSkin', new THREE.BufferAttribute(skin, 4));
+  geometry.setIndex(new THREE.BufferAttribute(surface.index.array, 1));
+  return geometry;
+}
+
+/** The program tape as a vec4 storage node (headers, then instructions), shared by every page. */
+export function programStorage(data) {
+  return instancedArray(new Float32Array(data.programData), 'vec4').toReadOnly();
+}
+
+/** Throws ThreeRevisionError unless the three.js in use is the release this package was built for. */
+export function assertThreeRevision(revision = THREE.REVISION) {
+  checkThreeRevision(revision);
+}
+
+/**
+ * Create a population. Options: capacity (bodies, default 64), pageSize (bodies per page and draw,
+ * at most what one storage binding of the device holds: DEFORM_STRIDE·16 bytes per vertex per body,
+ * default 64), tier (the built tier only), debugMode, surfaceUrl (the .glb's URL) or assetBase (the
+ * folder holding CREATURE.surfaceFile; default: this package's own assets/), support (a
+ * SupportSurfaceProvider, default flat ground at y = 0), gravity (a gravity provider, default standard
+ * gravity), water (a WaterSurfaceProvider: required for a swimmer, which is refused without one).
+ */
+export async function createCreaturePopulation(renderer, options = {}) {
+  assertThreeRevision();
+  assertWebGPU(renderer);
+  const data = CREATURE;
+  const capacity = options.capacity ?? 64;
+  const requestedPageSize = options.pageSize ?? 64;
+  if (!Number.isInteger(capacity) || capacity < 1) throw new Error(`capacity: must be a positive integer (got ${capacity})`);
+  if (!Number.isInteger(requestedPageSize) || requestedPageSize < 1) {
+    throw new Error(`pageSize: must be a positive integer (got ${requestedPageSize})`);
+  }
+  const support = options.support ?? createFlatGround();
+  const gravity = options.gravity ?? createGravity();
+  const water = options.water ?? null;
+  assertWaterFor(data.motion.type, water, `${data.slug}: options.water`);
+  const tier = options.tier ?? data.tier;
+  if (tier !== data.tier) throw new Error(`tier: this package was built for tier ${data.tier} (got ${tier}); rebuild with --tier ${tier}`);
+  const surface = await loadSurface(resolveSurfaceUrl(options, defaultSurfaceUrl));
+  const geometry = surfaceGeometry(surface);
+  const layout = layoutOf(data);
+  const programs = programStorage(data);
+  const records = vertexRecords(geometry);
+  const vertices = layout.vertices;
+  // A page's deform storage is one binding: it must fit the device's maxStorageBufferBindingSize.
+  const deformBytesPerBody = vertices * DEFORM_STRIDE * 16;
+  const bindingLimit = renderer.backend.device.limits.maxStorageBufferBindingSize;
+  const fitting = Math.floor(bindingLimit / deformBytesPerBody);
+  if (fitting < 1) {
+    throw new Error(`${data.slug}: one body's deform storage (${deformBytesPerBody} bytes) exceeds this device's `
+      + `maxStorageBufferBindingSize (${bindingLimit}); build a lighter tier`);
+  }
+  const pageSize = Math.min(requestedPageSize, capacity, fitting);
+  const floatsPerInstance = data.maxParts * data.poseRows * 4;
+  const group = new THREE.Group();
+  group.name = data.slug;
+  const variants = new Map();
+  const stats = {
+    uploads: 0, uploadBytes: 0, lastFrameBytes: 0, spawns: 0, ticks: 0, deformDispatches: 0, lastFrameDeformedVertices: 0,
+  };
+
+  const pages = [];
+  for (let first = 0; first < capacity; first += pageSize) {
+    const size = Math.min(pageSize, capacity - first);
+    const pose = instancedArray(new Float32Array(size * floatsPerInstance), 'vec4');
+    const mesh = new THREE.Mesh(geometry, null);
+    mesh.count = 0;
+    mesh.castShadow = true;
+    mesh.receiveShadow = true;
+    mesh.boundingSphere = new THREE.Sphere(new THREE.Vector3(), 0);
+    mesh.name = `${data.slug}.page${pages.length}`;
+    group.add(mesh);
+    const deform = deformStorage(size, vertices);
+    pages.push({
+      first, size, pose, mesh, staging: pose.value.array, deform, deformView: deformView(deform), kernels: new Map(), shell: null,
+      alive: new Uint8Array(size), seed: new Uint32Array(size), spawnTick: new Float64Array(size),
+      motions: new Array(size).fill(null), bounds: new Float64Array(6 * size),
+      genomes: new Float64Array(GENOME_LENGTH * size), colours: new Float64Array(3 * data.slotCount * size),
+      dirtyLo: Infinity, dirtyHi: -1,
+    });
+  }
+  const rootRow = data.slotCount * data.poseRows * 4;
+  const tmp = new Float64Array(3);
+  const localBox = new Float64Array(6);
+  const renderQuats = new Float64Array(4 * data.slotCount);
+  const renderTrans = new Float64Array(3 * data.slotCount);
+  const renderRoot = new Float64Array(6);
+  const driver = createDriver(data.tickRate);
+  const corner = new THREE.Vector3();
+  const box = new THREE.Box3();
+  let tick = 0;
+  let mode = checkDebugMode(options.debugMode ?? 'off');
+
+  const variantKey = (m) => [data.signatures.compilerSignature, data.signatures.topologySignature, data.tier, m, data.registers].join('|');
+  function materialFor(page, m) {
+    const key = `${variantKey(m === 'shell' ? 'off' : m)}|page${pages.indexOf(page)}`;
+    if (!variants.has(key)) variants.set(key, createBodyMaterial(layout, page.pose, page.deformView, m === 'shell' ? 'off' : m));
+    return variants.get(key);
+  }
+  // The pre-pass variant of a mode: 'skin-only' stores uncorrected positions, every other mode the body.
+  const kernelKind = (m) => (m === 'skin-only' ? 'skin-only' : 'body');
+  function kernelFor(page, kind) {
+    if (!page.kernels.has(kind)) {
+      const fns = bodyFunctions(layout, page.pose, programs);
+      page.kernels.set(kind, createDeformKernel(layout, fns, {
+        pose: page.pose, records, deform: page.deform, size: page.size, vertices, skinOnly: kind === 'skin-only',
+      }));
+    }
+    return page.kernels.get(kind);
+  }
+  function showMode(page, m) {
+    page.mesh.material = materialFor(page, m);
+    page.kernel = kernelFor(page, kernelKind(m));
+    if (m === 'shell' && !page.shell) {
+      page.shell = createShellMesh(layout, page.pose, page.mesh.name);
+      page.shell.boundingSphere = page.mesh.boundingSphere;
+      group.add(page.shell);
+    }
+    page.mesh.visible = m !== 'shell';
+    if (page.shell) {
+      page.shell.visible = m === 'shell';
+      page.shell.count = page.mesh.count * data.slotCount;
+    }
+  }
+  for (const page of pages) showMode(page, mode);
+
+  // One body's rows from per-slot transforms and a root (the motion's current step, or its render pose),
+  // and its world bounds; marks the instance dirty for the next flush.
+  function writeInstance(page, j, quats, trans, root) {
+    const base = j * floatsPerInstance;
+    const size = page.motions[j].size;
+    writePoseRows(data, quats, trans, page.colours, 3 * data.slotCount * j, tmp, page.staging, base, localBox, size);
+    writeRootRows(root, page.alive[j], page.staging, base + rootRow, size);
+    rootBounds(localBox, root, page.bounds, 6 * j);
+    page.dirtyLo = Math.min(page.dirtyLo, j);
+    page.dirtyHi = Math.max(page.dirtyHi, j);
+  }
+  function writeCurrent(page, j) {
+    const m = page.motions[j];
+    writeInstance(page, j, m.quats, m.trans, m.root);
+  }
+
+  function refreshBounds(page) {
+    box.makeEmpty();
+    let last = -1;
+    for (let j = 0; j < page.size; j++) {
+      if (!page.alive[j]) continue;
+      last = j;
+      const b = page.bounds;
+      box.expandByPoint(corner.set(b[6 * j], b[6 * j + 1], b[6 * j + 2]));
+      box.expandByPoint(corner.set(b[6 * j + 3], b[6 * j + 4], b[6 * j + 5]));
+    }
+    page.mesh.count = last + 1;
+    if (page.shell) page.shell.count = page.mesh.count * data.slotCount;
+    if (last < 0) page.mesh.boundingSphere.set(page.mesh.boundingSphere.center.set(0, 0, 0), 0);
+    else box.getBoundingSphere(page.mesh.boundingSphere);
+  }
+
+  // The pre-pass over instances lo..hi of a page, clipped to the drawn range (dead ones are skipped).
+  function deformRange(page, lo, hi) {
+    const top = Math.min(hi, page.mesh.count - 1);
+    if (top < lo) return 0;
+    stats.deformDispatches += 1;
+    return dispatchDeform(renderer, page.kernel, lo, top);
+  }
+
+  // One coalesced range per page: [first dirty instance, last dirty instance], uploaded once per flush,
+  // then that range deformed once (the upload rides on the dispatch's binding update).
+  function flush() {
+    let bytes = 0;
+    let deformed = 0;
+    for (const page of pages) {
+      if (page.dirtyHi < 0) continue;
+      const start = page.dirtyLo * floatsPerInstance;
+      const count = (page.dirtyHi - page.dirtyLo + 1) * floatsPerInstance;
+      page.pose.value.addUpdateRange(start, count);
+      page.pose.value.needsUpdate = true;
+      bytes += 4 * count;
+      refreshBounds(page);
+      deformed += deformRange(page, page.dirtyLo, page.dirtyHi);
+      page.dirtyLo = Infinity;
+      page.dirtyHi = -1;
+    }
+    stats.lastFrameDeformedVertices = deformed;
+    stats.lastFrameBytes = bytes;
+    stats.uploadBytes += bytes;
+    if (bytes) stats.uploads += 1;
+    return bytes;
+  }
+
+  function locate(id) {
+    if (!Number.isInteger(id) || id < 0 || id >= capacity) throw new Error(`id: ${id} is not an instance of this population (0..${capacity - 1})`);
+    const page = pages[Math.floor(id / pageSize)];
+    return { page, j: id - page.first };
+  }
+
+  // Every live body `n` fixed steps on (stepTicks and update share it: same ticks, same state).
+  function advance(n) {
+    for (const page of pages) {
+      for (let j = 0; j < page.size; j++) {
+        if (!page.alive[j]) continue;
+        const m = page.motions[j];
+        for (let k = 0; k < n; k++) m.step();
+      }
+    }
+    tick += n;
+    stats.ticks += n;
+  }
+
+  const population = {
+    object3d: group,
+    data,
+    pages,
+    layout,
+    programs,
+    geometry,
+    get tick() { return tick; },
+    get debugMode() { return mode; },
+    get capacity() { return capacity; },
+    /** Bodies per page (one draw each): the requested size, clamped to what one storage binding holds. */
+    get pageSize() { return pageSize; },
+    /** GPU bytes of deform storage per body (DEFORM_STRIDE vec4 per vertex). */
+    deformBytesPerBody,
+    get count() { return pages.reduce((n, p) => n + p.alive.reduce((a, b) => a + b, 0), 0); },
+    stats,
+    /** The support, gravity and water providers every body of this population stands, falls and swims on. */
+    support, gravity, water,
+    /**
+     * Validate and add one body at `position` (its path starts there; the locomotion core puts it on the
+     * support, on the water or at the flyer's altitude). Its seed is its genome (core/genome.js): heading,
+     * colour genes (hue, chroma, lightness in OKLab), gait genes and its size, within the package's genetics
+     * bounds.
+     * Builds its CPU motion state and writes O(slots) rows: no geometry, material, buffer or pipeline is
+     * created. Its motion starts at its own tick 0.
+     */
+    spawn({ seed = 0, position = [0, 0, 0] } = {}) {
+      if (!Number.isInteger(seed) || seed < 0 || seed > 0xffffffff) throw new Error(`spawn.seed: an integer in [0, 2^32) (got ${seed})`);
+      if (!Array.isArray(position) || position.length !== 3 || !position.every(Number.isFinite)) {
+        throw new Error('spawn.position: three finite numbers');
+      }
+      for (const page of pages) {
+        for (let j = 0; j < page.size; j++) {
+          if (page.alive[j]) continue;
+          const genome = drawGenome(seed, data.lcg, page.genomes.subarray(GENOME_LENGTH * j, GENOME_LENGTH * (j + 1)));
+          page.motions[j] = createMotion(data.motion, data.lcg, { support, gravity, water, seed, position, genome });
+          genomeColours(data, genome, page.colours, 3 * data.slotCount * j);
+          page.alive[j] = 1;
+          page.seed[j] = seed;
+          page.spawnTick[j] = tick;
+          writeCurrent(page, j);
+          stats.spawns += 1;
+          return page.first + j;
+        }
+      }
+      throw new Error(`spawn: the population is full (capacity ${capacity}); create it with a larger capacity`);
+    },
+    despawn(id) {
+      const { page, j } = locate(id);
+      page.alive[j] = 0;
+      page.motions[j] = null;
+      page.genomes.fill(0, GENOME_LENGTH * j, GENOME_LENGTH * (j + 1));
+      page.colours.fill(0, 3 * data.slotCount * j, 3 * data.slotCount * (j + 1));
+      page.staging.fill(0, j * floatsPerInstance, (j + 1) * floatsPerInstance);
+      page.dirtyLo = Math.min(page.dirtyLo, j);
+      page.dirtyHi = Math.max(page.dirtyHi, j);
+    },
+    /** Advance every body `n` whole fixed steps and upload the current step's pose (no interpolation). */
+    stepTicks(n = 1) {
+      if (!Number.isInteger(n) || n < 0) throw new Error(`stepTicks: a non-negative integer (got ${n})`);
+      advance(n);
+      for (const page of pages) for (let j = 0; j < page.size; j++) if (page.alive[j]) writeCurrent(page, j);
+      return flush();
+    },
+    /**
+     * Put the population at tick `n`: each body re-simulated from its spawn to its own tick
+     * n − spawnTick (0 if it was spawned later), so the state equals stepping there tick by tick.
+     */
+    seekTick(n) {
+      if (!Number.isInteger(n) || n < 0) throw new Error(`seekTick: a non-negative integer (got ${n})`);
+      for (const page of pages) {
+        for (let j = 0; j < page.size; j++) {
+          if (!page.alive[j]) continue;
+          page.motions[j].seekTick(Math.max(0, n - page.spawnTick[j]));
+          writeCurrent(page, j);
+        }
+      }
+      tick = n;
+      driver.reset();
+      return flush();
+    },
+    /**
+     * One render frame of `dt` seconds: the fixed-step driver (dt clamped to [0, 0.25] s, accumulator
+     * capped at 0.25 s) runs the whole steps due, then every body is drawn at the render pose interpolated
+     * between its previous and current step. Returns the number of steps run.
+     */
+    update(dt) {
+      const steps = driver.advance(dt);
+      advance(steps);
+      for (const page of pages) {
+        for (let j = 0; j < page.size; j++) {
+          if (!page.alive[j]) continue;
+          page.motions[j].renderPose(driver.alpha, renderQuats, renderTrans, renderRoot);
+          writeInstance(page, j, renderQuats, renderTrans, renderRoot);
+        }
+      }
+      flush();
+      return steps;
+    },
+    /** The fixed-step driver (hz, alpha, accumulator) update() uses. */
+    driver,
+    /** Upload whatever spawn/despawn left dirty (called by the owner before rendering). */
+    flush,
+    /** Internal: the page holding instance `id` and its index there. */
+    locate(id) {
+      const { page, j } = locate(id);
+      return { page, index: j };
+    },
+    instance(id) {
+      const { page, j } = locate(id);
+      const m = page.motions[j];
+      return { index: j, alive: page.alive[j] === 1, seed: page.seed[j], spawnTick: page.spawnTick[j],
+        tick: m ? m.tick : null, root: m ? Array.from(m.root) : null, bounds: Array.from(page.bounds.subarray(6 * j, 6 * j + 6)),
+        genome: m ? Array.from(page.genomes.subarray(GENOME_LENGTH * j, GENOME_LENGTH * (j + 1))) : null };
+    },
+    /** The locomotion core of a live instance (createMotion: state, gates, renderPose), or null. */
+    motion(id) {
+      const { page, j } = locate(id);
+      return page.motions[j];
+    },
+    /** Pose rows of one instance from the CPU staging copy (what the next upload sends). */
+    stagedPose(id) {
+      const { page, j } = locate(id);
+      return page.staging.slice(j * floatsPerInstance, (j + 1) * floatsPerInstance);
+    },
+    stateHash() {
+      return hashBytes(pages.map((p) => new Uint8Array(p.staging.buffer, p.staging.byteOffset, p.staging.byteLength)), tick);
+    },
+    /** Switch every page to debug mode `m` (a variant built on first use; 'off' is the shipped one). */
+    setDebugMode(m) {
+      checkDebugMode(m);
+      const rerun = kernelKind(m) !== kernelKind(mode);
+      for (const page of pages) {
+        showMode(page, m);
+        if (rerun) deformRange(page, 0, page.size - 1);
+      }
+      mode = m;
+    },
+    setTier(t) {
+      if (t !== data.tier) throw new Error(`tier: this package was built for tier ${data.tier} (got ${t}); rebuild with --tier ${t}`);
+    },
+    variantKeys() { return [...variants.keys()]; },
+    /** The rest-vertex records (deform.js) every page's pre-pass reads. */
+    records,
+    /**
+     * Build every shipped variant's pipelines (deform compute, display and shadow) and every page's deform
+     * storage before the first visible frame.
+     */
+    async warm(scene, camera) {
+      const saved = pages.map((p) => p.mesh.count);
+      for (const page of pages) page.mesh.count = Math.max(1, page.mesh.count);
+      for (const m of SHIPPED_VARIANTS) {
+        for (const page of pages) {
+          showMode(page, m);
+          dispatchDeform(renderer, page.kernel, 0, 0);
+        }
+        await renderer.compileAsync(scene, camera);
+      }
+      pages.forEach((p, i) => { p.mesh.count = saved[i]; showMode(p, mode); });
+    },
+    dispose() {
+      geometry.dispose();
+      for (const material of variants.values()) material.dispose();
+      for (const page of pages) if (page.shell) { page.shell.geometry.dispose(); page.shell.material.dispose(); }
+      group.removeFromParent();
+    },
+  };
+  return population;
+}

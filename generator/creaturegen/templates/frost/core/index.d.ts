@@ -1,0 +1,166 @@
+// Types of the pure-JS entry ('<package>/core'): no three.js types needed.
+
+/** One pointer move between two timestamped samples. Positions in history UV (origin top-left, v down). */
+export interface PointerSegment {
+  t0: number;
+  t1: number;
+  start: [number, number];
+  end: [number, number];
+  /** In [0, 1]; default 1. The segment deposits with the average of its two pressures. */
+  pressure0?: number;
+  pressure1?: number;
+}
+
+/** A segment with its defaults filled in. */
+export interface NormalizedSegment {
+  t0: number;
+  t1: number;
+  start: [number, number];
+  end: [number, number];
+  pressure0: number;
+  pressure1: number;
+}
+
+export type IntervalDecision = 'advance' | 'none' | 'discontinuity';
+
+/** One piecewise-constant input interval of a frame. */
+export interface FrameStep {
+  dt: number;
+  segment: NormalizedSegment | null;
+}
+
+export type TierName = 'full' | 'balanced' | 'budgeted';
+export type HistoryFormat = 'rgba16float' | 'rgba32float';
+
+/** The decay/deposit law of one history channel. */
+export interface ChannelParams {
+  decay: number;
+  fill: number;
+  radius: number;
+  noise: number;
+  [key: string]: unknown;
+}
+
+/** The simulation numbers of the plan (the same FrostParams creaturegen's numpy reference runs). */
+export interface FrostParams {
+  visible: ChannelParams;
+  tilt: ChannelParams;
+  softness: number;
+  diffusivity: number;
+  diffusionStability: number;
+  policy: 'full-field' | 'dirty-tiles';
+  tileSize: number;
+  idleWhenConverged: boolean;
+  tolerance: number;
+  maxInterval: number;
+  maxSteps: number;
+  discontinuity: 'reset' | 'freeze';
+  resizePolicy: 'clear' | 'preserve-remap';
+  historyScale: number;
+  seed: number;
+  workgroup2d: [number, number];
+  workgroupLinear: number;
+  [key: string]: unknown;
+}
+
+export interface TierSettings {
+  historyScale: number;
+  blurScale: number;
+  detail: boolean;
+  fresnel: boolean;
+}
+
+/** How one normal map follows from an 8-bit height plane of the structure file. */
+export interface NormalScale {
+  spacing: number;
+  scale: number;
+}
+
+/** The plan's description of the structure file (see decodeStructureFile). */
+export interface StructureFileLayout {
+  file: string;
+  bytes: number;
+  adler32: number;
+  sha256: string;
+  resolution: number;
+  planes: string[];
+  filters: Array<'none' | 'sub' | 'up' | 'gradient'>;
+  normals: { main: NormalScale; detail: NormalScale };
+}
+
+/** The build plan of this package, as data. */
+export interface FrostPlan {
+  readonly name: string;
+  readonly slug: string;
+  readonly version: string;
+  readonly specSha256: string;
+  readonly params: FrostParams;
+  readonly tier: { name: TierName; historyFormat: HistoryFormat; historyFormatRequested: string; maxHistoryScale: number };
+  readonly tiers: Record<TierName, TierSettings>;
+  readonly refraction: Record<string, number>;
+  readonly composite: Record<string, unknown>;
+  readonly fades: { side: number; corner: number };
+  readonly blur: { sigma: number; epsilon: number };
+  readonly structure: { resolution: number; seed: number; sha256: string; [key: string]: unknown };
+  readonly assets: { structure: StructureFileLayout };
+  readonly three: { revision: string; range: string };
+  readonly noiseSalts: number[];
+  readonly debugViews: string[];
+  readonly memory: Record<string, unknown>;
+  readonly gates: Array<Record<string, unknown>>;
+}
+
+export const PLAN: FrostPlan;
+
+/** 'advance' | 'none' (equal instants) | 'discontinuity' (reversed, non-finite or too long). */
+export function classifyInterval(previous: number, current: number, maxInterval: number): IntervalDecision;
+/** Why a segment is refused, or null. */
+export function validateSegment(segment: NormalizedSegment, lastEnd: number | null): string | null;
+export function normalizeSegment(segment: PointerSegment): NormalizedSegment;
+/** Pointer NDC in [-1, 1], y up, to history UV (origin top-left, v down). */
+export function pointerUV(ndcX: number, ndcY: number): [number, number];
+/** floor(x·scale + 0.5), at least 1, per axis. */
+export function scaledSize(width: number, height: number, scale: number): [number, number];
+/** Cut [previous, current) at every segment boundary inside it. */
+export function splitInterval(previous: number, current: number, segments: readonly NormalizedSegment[]): FrameStep[];
+export function chunkSteps(steps: readonly FrameStep[], maxSteps: number): FrameStep[][];
+/** Substeps keeping D·(dt/n)/dx² ≤ 1/4; 0 without diffusion. */
+export function diffusionSubsteps(diffusivity: number, dt: number, height: number, stability: number): number;
+
+/** Per-tile analytic bounds decide what a frame dispatches (see the README). */
+export class TileScheduler {
+  constructor(params: FrostParams, width: number, height: number);
+  readonly tileWidth: number;
+  readonly tileHeight: number;
+  readonly tilesX: number;
+  readonly tilesY: number;
+  readonly width: number;
+  readonly height: number;
+  readonly count: number;
+  /** Row-major tile ids to update / to retire after plan(). */
+  readonly update: Uint32Array;
+  readonly retire: Uint32Array;
+  plan(steps: readonly FrameStep[], frameDt: number, substeps: number): { updateCount: number; retireCount: number };
+  markAll(boundVisible: number, boundTilt: number): void;
+  maxBounds(): [number, number];
+}
+
+/** The installed three.js is not the release this package was written for. */
+export class FrostRevisionError extends Error {
+  constructor(message: string);
+}
+/** The three.js revision this package requires, e.g. '185'. */
+export const THREE_REVISION: string;
+/** Throws FrostRevisionError unless `revision` (three's REVISION) is this package's release. */
+export function checkThreeRevision(revision: string | number): void;
+
+/** A fetched asset is not this package's file (wrong size or content, or a failed download). */
+export class FrostAssetError extends Error {
+  constructor(message: string);
+}
+/** Decode the structure file into the RGBA8 structure and normal maps the GPU samples (N × N each). */
+export function decodeStructureFile(
+  bytes: Uint8Array,
+  layout: StructureFileLayout,
+  source?: string,
+): Promise<{ structure: Uint8Array; normals: Uint8Array }>;

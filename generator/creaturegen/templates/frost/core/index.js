@@ -1,0 +1,9 @@
+// Pure-JS entry (no three imports): plan data, time policy, input intervals, tile scheduler, the structure
+// file decoder and the three.js release check.
+export { PLAN } from './plan.js';
+export {
+  TileScheduler, chunkSteps, classifyInterval, diffusionSubsteps, normalizeSegment, pointerUV, scaledSize,
+  splitInterval, validateSegment,
+} from './frost-core.js';
+export { FrostRevisionError, THREE_REVISION, checkThreeRevision } from './revision.js';
+export { FrostAssetError, decodeStructureFile } from './structure-file.js';

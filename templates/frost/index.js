@@ -1,2 +1,0 @@
-export { PLAN, pointerUV, TileScheduler } from './core/index.js';
-export { DEBUG_VIEWS, createFrostEffect } from './tsl/index.js';

@@ -1,3 +1,0 @@
-// three r185 WebGPU/TSL entry: the effect, its blur node.
-export { DEBUG_VIEWS, createFrostEffect } from './frost-effect.js';
-export { SeparableBlurNode, gaussianWeights } from './separable-blur.js';

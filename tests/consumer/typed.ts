@@ -1,0 +1,31 @@
+// A typed use of every public export of the two creature packages and the frost package, checked with
+// `tsc --strict` by tests/test_consumer.py: an export without a declaration, or a declaration that does
+// not match the README's use, fails the check.
+import * as THREE from 'three/webgpu';
+import {
+  CREATURE,
+  DEBUG_MODES,
+  createAnalyticWater,
+  createCreaturePopulation,
+  createDiagnostics,
+  createMotion,
+} from 'hopper-squash-core';
+import { createCreaturePopulation as createQuadrupeds } from 'quadruped-rope-tail';
+import { createFrostEffect } from 'frost-pane-balanced';
+
+export async function typed(renderer: THREE.WebGPURenderer, scene: THREE.Scene, camera: THREE.Camera): Promise<number> {
+  const hoppers = await createCreaturePopulation(renderer, { capacity: 4, water: createAnalyticWater() });
+  const quadrupeds = await createQuadrupeds(renderer, { capacity: 2 });
+  const id: number = hoppers.spawn({ seed: 7, position: [0, 0, 0] });
+  quadrupeds.spawn({ seed: 1 });
+  const steps: number = hoppers.update(1 / 60);
+  hoppers.setDebugMode(DEBUG_MODES[0]);
+  const diagnostics = createDiagnostics(renderer, hoppers);
+  const pose: Float32Array = await diagnostics.readPose(id);
+  const slug: string = CREATURE.slug;
+  const motion = createMotion(CREATURE.motion, CREATURE.lcg, { seed: 1 });
+  const frost = await createFrostEffect(renderer, scene, camera);
+  frost.update(0, 1 / 60);
+  frost.render();
+  return steps + pose.length + slug.length + (motion ? 1 : 0);
+}
