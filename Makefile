@@ -32,16 +32,21 @@ PYTEST_WORKERS ?= 2
 CORPUS_COUNT ?= 200
 CORPUS_TIERS ?= hero,repeated,distant
 CORPUS_JOBS ?= $(shell nproc 2>/dev/null || echo 2)
+# `make fuzz`: documents through the spec gate and real builds of mutated valid specs (make test runs a
+# fixed 2,000-case subset, tests/test_fuzz.py).
+FUZZ_CASES ?= 50000
+FUZZ_BUILDS ?= 50
 # Only folders that exist: git does not keep empty ones, and ruff fails on a missing path.
 LINT_PATHS := $(wildcard generator tests bench)
 
-.PHONY: help setup system-deps build parity corpus test schemas lab bench golden clean distclean
+.PHONY: help setup system-deps build parity corpus fuzz test schemas lab bench golden clean distclean
 
 help:
 	@echo "make setup    .venv + pip install -e '.[dev]', npm ci in $(WEB_LAB), chromium + lavapipe"
 	@echo "make build    creaturegen build \$$EXAMPLE (now $(EXAMPLE)) into out/"
 	@echo "make parity   build every frost and creature example and run its parity job (out/<slug>/parity/)"
 	@echo "make corpus   build $(CORPUS_COUNT) generated creatures at $(CORPUS_TIERS): out/corpus/report.json, index.html"
+	@echo "make fuzz     $(FUZZ_CASES) hostile/mutated specs through the gate + $(FUZZ_BUILDS) real builds: out/fuzz/report.json"
 	@echo "make test     ruff, ruff format --check, mypy, pytest (browser tests included)"
 	@echo "make schemas  export JSON Schemas into schemas/"
 	@echo "make golden   rebuild tests/golden/ (the byte-for-byte package records); review and commit the diff"
@@ -49,7 +54,8 @@ help:
 	@echo "make bench    bench/results/field.json (candidates, analytic vs FD), frost.json (tiers, tiles, idle),"
 	@echo "              surface.json (narrow band vs dense, numpy vs wgpu, extraction, gates),"
 	@echo "              runtime.json (creature frame p50/p95 vs bodies, per-body cost, baseline vs 7P/K, spawns),"
-	@echo "              motion.json (locomotion core in Node: µs per creature per step, rope cost, allocation)"
+	@echo "              motion.json (locomotion core in Node: µs per creature per step, rope cost, allocation),"
+	@echo "              validate.json (the spec gate on the worst shapes up to the 1 MiB limit)"
 	@echo "make clean    remove build output and caches; distclean also removes .venv and node_modules"
 
 # --- setup ------------------------------------------------------------------------------------
@@ -95,6 +101,10 @@ corpus: $(VENV_STAMP)
 	@echo "==> corpus: $(CORPUS_COUNT) generated creatures at $(CORPUS_TIERS), $(CORPUS_JOBS) builds at a time"
 	$(VENV_PY) -m creaturegen.corpus --count $(CORPUS_COUNT) --tiers $(CORPUS_TIERS) --jobs $(CORPUS_JOBS) -o out/corpus
 
+fuzz: $(VENV_STAMP)
+	@echo "==> fuzz: $(FUZZ_CASES) documents through the spec gate, $(FUZZ_BUILDS) builds of mutated valid specs"
+	$(VENV_PY) tools/fuzz.py --cases $(FUZZ_CASES) --builds $(FUZZ_BUILDS) -o out/fuzz
+
 schemas: $(VENV_STAMP)
 	@echo "==> exporting JSON Schemas into schemas/"
 	$(VENV)/bin/creaturegen schema --out schemas
@@ -115,6 +125,8 @@ bench: setup
 	$(VENV_PY) bench/surface.py --out bench/results/surface.json
 	@echo "==> runtime benchmark (creature population on WebGPU/SwiftShader, shipped vs forbidden baseline) into bench/results/runtime.json"
 	$(VENV_PY) bench/runtime.py --out bench/results/runtime.json
+	@echo "==> validation benchmark (the spec gate on the worst 1 MiB shapes) into bench/results/validate.json"
+	$(VENV_PY) bench/validate.py --out bench/results/validate.json
 	@echo "==> motion benchmark (locomotion core in Node: cost per step, rope cost, allocation) into bench/results/motion.json"
 	$(VENV_PY) bench/motion.py --out bench/results/motion.json
 
@@ -128,7 +140,7 @@ test: setup
 	@echo "==> mypy"
 	$(VENV)/bin/mypy generator
 	@echo "==> pytest"
-	$(VENV_PY) -m pytest -n $(PYTEST_WORKERS) $(PYTEST_ARGS)
+	CREATUREGEN_STRICT_SETUP=1 $(VENV_PY) -m pytest -n $(PYTEST_WORKERS) $(PYTEST_ARGS)
 
 # --- housekeeping -----------------------------------------------------------------------------
 

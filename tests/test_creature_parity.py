@@ -184,4 +184,135 @@ def test_the_job_catches_a_population_that_uploads_a_stale_pose(out_root: Path, 
     report = run_creature_parity(planted, groups=("field", "motion"))
     failed = {g["name"] for g in report.gates if g["status"] == "fail"}
     assert "planted feet in the GPU pose buffer vs their plant points" in failed, report.summary()
+    assert "pose rows (slots and root): GPU vs the Python locomotion reference" in failed, report.summary()
     assert "motion state in the lab vs Python at tick 37 (relative)" not in failed, report.summary()
+
+
+@pytest.mark.browser
+def test_the_job_fails_on_what_the_page_logs(out_root: Path, tmp_path: Path) -> None:
+    """r185 reports a failed pipeline with console.error inside an error scope and skips the draw, which
+    renderer.onError never sees: the job gates the console itself (here a warning the package logs)."""
+    package = build("reference/hopper.json", out_root)
+    planted = _planted(
+        package,
+        tmp_path,
+        "population.js",
+        [
+            (
+                "export async function createCreaturePopulation(renderer, options = {}) {",
+                "export async function createCreaturePopulation(renderer, options = {}) {\n"
+                "  console.error('THREE.WebGPURenderer: planted pipeline failure');",
+            )
+        ],
+    )
+    report = run_creature_parity(planted, groups=("hash",))
+    failed = {g["name"] for g in report.gates if g["status"] == "fail"}
+    assert failed == {"console errors and warnings (pipeline compiles included)"}, report.summary()
+
+
+def test_the_adapter_gate_fails_off_swiftshader() -> None:
+    from creaturegen.lab.creature_parity import adapter_gate
+    from creaturegen.lab.report import ParityReport
+
+    report = ParityReport(package="planted")
+    adapter_gate(report, {"architecture": "swiftshader", "vendor": "google", "description": None})
+    adapter_gate(report, {"architecture": "gen-12lp", "vendor": "intel", "description": "Mesa Intel"})
+    assert [g["status"] for g in report.gates] == ["pass", "fail"]
+
+
+@pytest.mark.browser
+@pytest.mark.parametrize(
+    ("planted_defect", "swap", "gate"),
+    [
+        (
+            "yaw",
+            ("root1.x.mul(v.x).add(root1.y.mul(v.z))", "root1.x.mul(v.x).sub(root1.y.mul(v.z))"),
+            "display path world positions vs numpy's root transform",
+        ),
+        (
+            "squash",
+            ("p.y.mul(root1.z)", "p.y.div(root1.z)"),
+            "display path world positions vs numpy's root transform",
+        ),
+        (
+            "normal",
+            (
+                "return rootRotate(root1, normalize(vec3(n.x.mul(q), n.y.div(root1.z), n.z.mul(q))));",
+                "return normalize(vec3(n.x.mul(q), n.y.div(root1.z), n.z.mul(q)));",
+            ),
+            "display path normals vs numpy (median)",
+        ),
+    ],
+)
+def test_the_job_catches_a_wrong_display_transform(
+    out_root: Path, tmp_path: Path, planted_defect: str, swap: tuple[str, str], gate: str
+) -> None:
+    """The root transform runs only in the display and shadow shaders (material.js); every other readback
+    is taken before it. The display-path readback renders the material's own positionNode."""
+    package = build("reference/hopper.json", out_root)
+    planted = _planted(package, tmp_path, "material.js", [swap])
+    report = run_creature_parity(planted, groups=("skin",))
+    failed = {g["name"] for g in report.gates if g["status"] == "fail"}
+    assert gate in failed, f"{planted_defect}: {report.summary()}"
+
+
+@pytest.mark.browser
+def test_the_job_catches_a_spawn_that_creates_a_buffer(out_root: Path, tmp_path: Path) -> None:
+    """Spawning is an O(slots) write into existing storage: a spawn that allocates fails the counter gate."""
+    package = build("reference/hopper.json", out_root)
+    planted = _planted(
+        package,
+        tmp_path,
+        "population.js",
+        [
+            (
+                "    spawn({ seed = 0, position = [0, 0, 0] } = {}) {",
+                "    spawn({ seed = 0, position = [0, 0, 0] } = {}) {\n"
+                "      renderer.backend.device.createBuffer({ size: 16, usage: 0x0040 }).destroy();",
+            )
+        ],
+    )
+    report = run_creature_parity(planted, groups=("population",))
+    failed = {g["name"] for g in report.gates if g["status"] == "fail"}
+    assert f"buffers created by {SPAWNS} spawns after reveal" in failed, report.summary()
+
+
+@pytest.mark.browser
+def test_the_job_catches_a_wrong_gradient(out_root: Path, tmp_path: Path) -> None:
+    """A blend gradient with its y component doubled leaves every distance right and every normal wrong."""
+    package = build("reference/hopper.json", out_root)
+    planted = _planted(
+        package,
+        tmp_path,
+        "field.js",
+        [
+            (
+                "return vec4(d, l.yzw.mul(omh).add(r.yzw.mul(h)));",
+                "return vec4(d, l.yzw.mul(omh).add(r.yzw.mul(h)).mul(vec3(1, 2, 1)));",
+            )
+        ],
+    )
+    report = run_creature_parity(planted, groups=("field",))
+    failed = {g["name"] for g in report.gates if g["status"] == "fail"}
+    assert "field normal angle GPU vs numpy (off seams)" in failed, report.summary()
+    assert not any(name.startswith("field |d_gpu - d_numpy|") for name in failed), report.summary()
+
+
+@pytest.mark.browser
+def test_the_job_catches_corrections_outside_the_region_policy(out_root: Path, tmp_path: Path) -> None:
+    """Every vertex given a trust radius corrects vertices the build never proved need it."""
+    package = build("reference/hopper.json", out_root)
+    planted = _planted(
+        package,
+        tmp_path,
+        "body.js",
+        [
+            (
+                "fns.skin.correctVertex(skinned, base, program, skin.y.mul(s))",
+                "fns.skin.correctVertex(skinned, base, program, float(layout.bodyScale * 0.01).mul(s))",
+            )
+        ],
+    )
+    report = run_creature_parity(planted, groups=("skin",))
+    failed = {g["name"] for g in report.gates if g["status"] == "fail"}
+    assert "corrections outside the region policy" in failed, report.summary()

@@ -23,7 +23,7 @@ from typing import Any
 import numpy as np
 import pytest
 
-from conftest import EXAMPLES, build_example, node, run_cli, shared_folder
+from conftest import EXAMPLES, build_example, missing_setup, node, run_cli, shared_folder
 from creaturegen.creature.assets import (
     REPORT_PATH,
     SIDECAR_PATH,
@@ -611,7 +611,7 @@ def typescript(tmp_path_factory: pytest.TempPathFactory) -> Path:
             timeout=300,
         )
         if done.returncode != 0:
-            pytest.skip(f"npm could not install TypeScript and {THREE_TYPES}: {done.stderr.strip()[-300:]}")
+            missing_setup(f"npm could not install TypeScript and {THREE_TYPES}: {done.stderr.strip()[-300:]}")
     return root
 
 

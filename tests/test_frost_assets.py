@@ -20,7 +20,9 @@ import numpy as np
 import pytest
 
 from conftest import EXAMPLES, run_cli
+from creaturegen.frost.brush import Segment
 from creaturegen.frost.structure import generate_structure
+from creaturegen.frost.timeline import late_steps
 from creaturegen.lab.browser import launch_lab_page
 from creaturegen.lab.frost_parity import shipped_structure
 from creaturegen.lab.server import WEB_LAB, serve
@@ -378,3 +380,37 @@ def test_readme_page_script_runs_as_written(packages: dict[str, Path], tmp_path:
         errors = [line for line in lab.console if line.startswith(("[error]", "[warning]"))]
         assert errors == [], lab.transcript()
         assert lab.page_errors == [], lab.transcript()
+
+
+def test_js_late_steps_are_the_numpy_late_steps(packages: dict[str, Path]) -> None:
+    # The JS core's catch-up steps (what the runtime writes to the step buffer) against numpy's, for
+    # segments before, across and after `previous`, one clipped by the origin, and from a start index.
+    raw = [
+        (0.05, 0.12, (0.1, 0.2), (0.2, 0.3)),
+        (0.12, 0.31, (0.2, 0.3), (0.4, 0.35)),
+        (0.31, 0.52, (0.4, 0.35), (0.6, 0.5)),
+        (0.52, 0.7, (0.6, 0.5), (0.7, 0.5)),
+    ]
+    segments = [Segment(t0=a, t1=b, start=s, end=e, pressure0=0.5, pressure1=0.9) for a, b, s, e in raw]
+    core = packages["budgeted"] / "core" / "frost-core.js"
+    script = f"""
+const {{ lateSteps, normalizeSegment }} = await import({json.dumps(core.as_uri())});
+const raw = {json.dumps([[a, b, list(s), list(e)] for a, b, s, e in raw])};
+const segs = raw.map(([t0, t1, start, end]) =>
+  normalizeSegment({{ t0, t1, start, end, pressure0: 0.5, pressure1: 0.9 }}));
+const out = [];
+for (const [previous, origin, from] of [[0.5, 0.0, 0], [0.5, 0.2, 0], [0.5, 0.0, 1], [0.9, 0.6, 0]]) {{
+  out.push(lateSteps(previous, segs, origin, from).map((s) => [segs.indexOf(s.segment), s.dt, s.age]));
+}}
+console.log(JSON.stringify(out));
+"""
+    done = run_node(script, packages["budgeted"])
+    assert done.returncode == 0, done.stderr
+    got = json.loads(done.stdout)
+    cases = [(0.5, 0.0, 0), (0.5, 0.2, 0), (0.5, 0.0, 1), (0.9, 0.6, 0)]
+    for (previous, origin, start), js in zip(cases, got, strict=True):
+        expected = [
+            [segments.index(s.segment), s.dt, s.age]  # type: ignore[arg-type]
+            for s in late_steps(previous, segments[start:], origin)
+        ]
+        assert js == expected, (previous, origin, start)

@@ -235,9 +235,8 @@ def test_readme_snippet_is_the_shipped_example(built: dict[str, Path], example: 
         "await renderer.init()",
         "setAnimationLoop",
         "addEventListener('resize'",
-        "addEventListener('pointermove'",
+        "frost.attachPointer(renderer.domElement)",
         "frost.resize(",
-        "frost.pointer(",
         "frost.update(",
         "frost.render()",
     ):
@@ -381,7 +380,18 @@ def test_requested_format_that_fails_the_gate_writes_nothing(tmp_path: Path) -> 
     source.write_text(json.dumps(spec))
     out = tmp_path / "out"
     result = build(source, out)
-    assert result.returncode == 2, result.stdout + result.stderr
+    assert result.returncode == 3, result.stdout + result.stderr  # a valid spec a build gate refuses
     assert "tier.historyFormat" in result.stderr
     assert "auto" in result.stderr
+    assert not out.exists() or list(out.iterdir()) == []
+
+
+def test_auto_refuses_when_no_format_passes(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    """The format gate can fail in "auto" too: with a tolerance no format meets, nothing ships (exit 3)."""
+    from creaturegen.cli import main
+    from creaturegen.frost import formats
+
+    monkeypatch.setattr(formats, "HALF_FLOAT_TOLERANCE", 0.0)
+    out = tmp_path / "out"
+    assert main(["build", str(EXAMPLES / "frost" / "frost-budgeted.json"), "-o", str(out)]) == 3
     assert not out.exists() or list(out.iterdir()) == []

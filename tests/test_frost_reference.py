@@ -14,11 +14,24 @@ import pytest
 from conftest import EXAMPLES
 from creaturegen.frost import formats, law, path
 from creaturegen.frost.brush import Segment, capsule_distance, coverage, pcg_hash, texel_noise
-from creaturegen.frost.formats import HALF_FLOAT_TOLERANCE, FormatGate, choose_format, measure_format
+from creaturegen.frost.formats import (
+    HALF_FLOAT_TOLERANCE,
+    FormatGate,
+    FormatRefusedError,
+    choose_format,
+    measure_format,
+)
 from creaturegen.frost.params import DIFFUSION_STABILITY, FrostParams, frost_params
 from creaturegen.frost.reference import STATE_CHANNELS, FrostReference, remap_bilinear
 from creaturegen.frost.schedule import TileScheduler, diffusion_substeps
-from creaturegen.frost.timeline import Step, chunk_steps, classify_interval, split_interval, validate_segment
+from creaturegen.frost.timeline import (
+    Step,
+    chunk_steps,
+    classify_interval,
+    late_steps,
+    split_interval,
+    validate_segment,
+)
 from creaturegen.spec import FrostEffectSpec, load_spec
 
 FROST_EXAMPLES = ("frost-full", "frost-balanced", "frost-budgeted")
@@ -598,8 +611,69 @@ def test_choose_format_auto() -> None:
 
 @pytest.mark.usefixtures("cached_gates")
 def test_choose_format_explicit_failure_is_an_error() -> None:
-    with pytest.raises(ValueError, match="auto"):
+    with pytest.raises(FormatRefusedError, match="auto"):
         choose_format(params_of("frost-full"), "rgba16float")
     chosen, gates = choose_format(params_of("frost-full"), "rgba32float")
     assert chosen == "rgba32float"
     assert [g.format for g in gates] == ["rgba32float"]
+
+
+def replay_arriving_late(params: FrostParams, fps: int) -> FrostReference:
+    """The conformance path as a real pointer delivers it: each segment is queued only once its end sample
+    has arrived, i.e. before the first update whose current instant reaches t1; most overlap an instant
+    that has already been rendered."""
+    reference = FrostReference(params, *GRID)
+    pending = list(path.conformance_segments())
+    for previous, current in itertools.pairwise(path.frame_instants(fps)):
+        while pending and pending[0].t1 <= current:
+            reference.queue(pending.pop(0))
+        reference.update(previous, current)
+    return reference
+
+
+@pytest.mark.parametrize("example", FROST_EXAMPLES)
+def test_late_segments_are_caught_up_exactly(example: str) -> None:
+    # A segment known only after the instant it overlaps still deposits its whole span: the decay-only
+    # part is turned into the deposit exactly, so late arrival at 30, 60 and 120 FPS gives the history of
+    # the segments all known in advance, and the pointer time deposited is the stroke's duration.
+    params = dataclasses.replace(params_of(example), diffusivity=0.0)
+    known, _ = replay_states(params, 60)
+    for fps in path.FRAME_RATES:
+        late = replay_arriving_late(params, fps)
+        worst = float(np.abs(late.state - known.state).max())
+        assert worst <= 1e-12, f"{example} late arrival at {fps} FPS differs by {worst:.3g}"
+        assert sum(r.late_steps for r in late.counters.history) > 0
+        assert late.counters.pointer_seconds == pytest.approx(path.STROKE_SECONDS, abs=1e-12)
+
+
+def test_catch_up_turns_decay_into_deposit_then_decay() -> None:
+    x0 = np.array([0.0, 0.2, 0.7, 1.0])
+    b = np.array([0.0, 0.3, 1.0, 0.6])
+    decay, fill, tau, age = 0.4, 5.0, 0.07, 0.13
+    decayed = law.advance(law.advance(x0, 0.0, tau, decay, fill), 0.0, age, decay, fill)
+    exact = law.advance(law.advance(x0, b, tau, decay, fill), 0.0, age, decay, fill)
+    assert np.abs(law.catch_up(decayed, b, tau, age, decay, fill) - exact).max() <= 1e-15
+    # a = 0 (no decay, no coverage) keeps x.
+    assert law.catch_up(x0, 0.0, tau, age, 0.0, fill).tolist() == x0.tolist()
+
+
+def test_late_steps_clip_to_the_origin_and_to_previous() -> None:
+    early = Segment(t0=0.1, t1=0.3, start=(0.2, 0.5), end=(0.4, 0.5))
+    spanning = Segment(t0=0.3, t1=0.6, start=(0.4, 0.5), end=(0.6, 0.5))
+    steps = late_steps(0.5, [early, spanning], origin=0.2)
+    assert [(s.segment, s.dt, s.age) for s in steps] == [
+        (early, pytest.approx(0.1), pytest.approx(0.2)),
+        (spanning, pytest.approx(0.2), 0.0),
+    ]
+    assert late_steps(0.5, [early], origin=0.35) == []
+
+
+def test_segments_from_before_a_discontinuity_deposit_nothing() -> None:
+    params = dataclasses.replace(params_of("frost-budgeted"), discontinuity="freeze", diffusivity=0.0)
+    reference = FrostReference(params, *GRID)
+    reference.update(0.0, 0.1)
+    reference.update(0.1, 5.0)  # longer than maxInterval: a discontinuity; the timeline restarts at 5.0
+    reference.queue(Segment(t0=4.0, t1=4.9, start=(0.3, 0.5), end=(0.7, 0.5)))
+    reference.update(5.0, 5.1)
+    assert float(np.abs(reference.state).max()) == 0.0
+    assert reference.counters.pointer_seconds == 0.0

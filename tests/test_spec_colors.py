@@ -10,7 +10,7 @@ import jsonschema
 import numpy as np
 import pytest
 
-from conftest import EXAMPLES, REPO
+from conftest import EXAMPLES, REPO, missing_setup
 from creaturegen.rig import compile_rig
 from creaturegen.spec import CharacterSpec, FrostEffectSpec, SpecValidationError, validate_bytes
 from creaturegen.spec.colors import CSS_NAMED_COLORS
@@ -46,7 +46,7 @@ def test_the_148_css_level_4_names_with_both_grey_spellings() -> None:
 def test_the_names_mean_what_three_js_means() -> None:
     """Same table as three's Color.NAMES, so a name is the same colour in the lab and in a user's scene."""
     if not THREE_COLOR_JS.is_file():
-        pytest.skip("web_lab/node_modules is not installed")
+        missing_setup("web_lab/node_modules is not installed")
     block = re.search(r"_colorKeywords = \{(.*?)\};", THREE_COLOR_JS.read_text(), re.S)
     assert block is not None
     three = {

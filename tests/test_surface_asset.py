@@ -13,7 +13,7 @@ import numpy as np
 import numpy.typing as npt
 import pytest
 
-from conftest import REPO
+from conftest import REPO, missing_setup
 from creaturegen import __version__
 from creaturegen.surface.asset import (
     ARRAY_BUFFER,
@@ -279,9 +279,9 @@ def test_sidecar_is_deterministic(tmp_path: Path) -> None:
 def run_three(path: Path, *flags: str) -> dict[str, object]:
     node = shutil.which("node")
     if node is None:
-        pytest.skip("node is not installed")
+        missing_setup("node is not installed")
     if not THREE.exists():
-        pytest.skip("web_lab/node_modules is missing (npm ci in web_lab)")
+        missing_setup("web_lab/node_modules is missing (npm ci in web_lab)")
     result = subprocess.run(
         [node, str(CHECK_GLB), str(path), *flags], capture_output=True, text=True, check=False, timeout=120
     )

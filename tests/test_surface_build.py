@@ -130,16 +130,17 @@ def _package_digest(folder: Path) -> str:
     return h.hexdigest()
 
 
-def test_cli_build_is_byte_identical_across_backends_and_caches(tmp_path: Path) -> None:
+def test_cli_build_is_byte_identical_across_backends_and_caches(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
     spec = str(EXAMPLES / "reference" / "hopper.json")
     digests = []
     for n, backend in enumerate(("numpy", "wgpu", "wgpu")):
         env_cache = tmp_path / f"cache-{min(n, 1)}"  # the third run reuses the second's cache: a hit
-        os.environ["CREATUREGEN_CACHE"] = str(env_cache)
-        try:
-            result = run_cli("build", spec, "-o", str(tmp_path / f"out-{n}"), "--backend", backend)
-        finally:
-            del os.environ["CREATUREGEN_CACHE"]
+        # monkeypatch restores the run's own cache afterwards (deleting it sent later tests on this
+        # worker into the user's real cache)
+        monkeypatch.setenv("CREATUREGEN_CACHE", str(env_cache))
+        result = run_cli("build", spec, "-o", str(tmp_path / f"out-{n}"), "--backend", backend)
         assert result.returncode == 0, result.stderr
         if n == 2:
             assert "cache hit" in result.stdout + result.stderr

@@ -26,7 +26,7 @@ import numpy as np
 import numpy.typing as npt
 import pytest
 
-from conftest import EXAMPLES
+from conftest import EXAMPLES, missing_setup
 from creaturegen.field import layout
 from creaturegen.rig import CompiledRig, compile_rig
 from creaturegen.rig.graph import BlendGraph, Ref
@@ -49,7 +49,7 @@ def _adapter() -> None:
     try:
         _device()
     except BackendUnavailableError as exc:
-        pytest.skip(f"no wgpu adapter: {exc}")
+        missing_setup(f"no wgpu adapter: {exc}")
 
 
 @cache

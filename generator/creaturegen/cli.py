@@ -28,13 +28,14 @@ from .creature.picture import PICTURE_PATH, picture_unavailable
 from .emit import PackageWriteError
 from .field.sampler import sample
 from .frost.build import build_frost
+from .frost.formats import FormatRefusedError
 from .rig import CompiledRig, RigCompileError, compile_rig
 from .rig.report import describe_rig
 from .spec import CharacterSpec, SpecError, SpecValidationError, load_spec, slugify, validate_bytes
 from .spec.schema import stale_schemas, write_schemas
 from .spec.summary import summarize
 from .surface.asset import SurfaceCache
-from .surface.backends import BACKENDS
+from .surface.backends import BACKENDS, BackendChoiceError
 from .surface.build import DEFAULT_TIER, SurfaceBuild, SurfaceRejectedError, build_surface
 from .surface.deform import DeformationError
 from .surface.grid import GridTooFineError
@@ -125,15 +126,17 @@ def _build(args: argparse.Namespace) -> int:
     )
     try:
         folder = build_frost(spec, data, Path(args.out))
-    except ValueError as exc:
+    except FormatRefusedError as exc:
         print_errors(args.spec, [SpecError("tier.historyFormat", str(exc))])
-        return EXIT_INVALID
+        return EXIT_REFUSED
     except PackageWriteError as exc:
         print(f"{args.spec}: cannot write the package: {exc}", file=sys.stderr)
         return EXIT_INVALID
     report = json.loads((folder / "build-report.json").read_text())
     for gate in report["gates"]:
-        verdict = "pass" if gate["status"] == "pass" else "fail, so this format is not used"
+        verdict = (
+            "pass" if gate["status"] == "pass" else "fail, so this format is not used (a later one passed)"
+        )
         print(f"  gate {gate['name']}: {gate['value']:.3g} (threshold {gate['threshold']:.3g}) {verdict}")
     print(f"  history format {report['historyFormat']['historyFormat']}")
     print(f"wrote {folder}/")
@@ -149,7 +152,7 @@ def _surface(name: str, spec: CharacterSpec, rig: CompiledRig, tier: str, backen
     except (SurfaceRejectedError, GridTooFineError, DeformationError) as exc:
         print_errors(name, [SpecError(f"surface.{tier}", str(exc))])
         return EXIT_REFUSED
-    except ValueError as exc:
+    except BackendChoiceError as exc:
         print_errors(name, [SpecError("--backend", str(exc))])
         return EXIT_INVALID
 
@@ -578,6 +581,7 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def main(argv: Sequence[str] | None = None) -> int:
+    from .motion.derived import MotionRangeError
     from .resources import MissingResourceError
 
     args = build_parser().parse_args(argv)
@@ -586,6 +590,9 @@ def main(argv: Sequence[str] | None = None) -> int:
     except MissingResourceError as exc:  # a broken install: say what is missing, write nothing
         print(f"creaturegen: {exc}", file=sys.stderr)
         return EXIT_INVALID
+    except MotionRangeError as exc:  # a valid spec whose motion cannot be stepped: refused by name
+        print(f"{getattr(args, 'spec', 'creaturegen')}: {exc}", file=sys.stderr)
+        return EXIT_REFUSED
     return code
 
 

@@ -21,6 +21,25 @@ def to_json(value: Any, indent: int | None = 2) -> str:
     return json.dumps(value, indent=indent, sort_keys=True, ensure_ascii=True, allow_nan=False)
 
 
+#: Characters Markdown or HTML would act on in a README (emphasis, links, images, headings, tables, raw
+#: HTML, entities): a spec's name is shown as the text it is, never as markup.
+_MARKDOWN_ACTIVE = frozenset("\\`*_{}[]()<>#!|&~\"'")
+
+
+def markdown_text(value: Any) -> str:
+    """User text as inert Markdown/HTML: active characters backslash-escaped or entity-encoded (so
+    ``</script>`` and ``[x](javascript:…)`` render as themselves on npm and GitHub)."""
+    out = []
+    for ch in str(value):
+        if ch in "<>&\"'":
+            out.append(f"&#{ord(ch)};")
+        elif ch in _MARKDOWN_ACTIVE:
+            out.append("\\" + ch)
+        else:
+            out.append(ch)
+    return "".join(out)
+
+
 def environment(folder: Path) -> jinja2.Environment:
     env = jinja2.Environment(
         loader=jinja2.FileSystemLoader(str(folder)),
@@ -31,6 +50,7 @@ def environment(folder: Path) -> jinja2.Environment:
         lstrip_blocks=True,
     )
     env.filters["tojson_sorted"] = to_json
+    env.filters["markdown_text"] = markdown_text
     return env
 
 

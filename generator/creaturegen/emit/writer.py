@@ -83,11 +83,15 @@ def write_package(
     """
     if not slug or "/" in slug or slug in {".", ".."}:
         raise PackageWriteError(f"invalid package folder name {slug!r}")
-    out_root.mkdir(parents=True, exist_ok=True)
-    final = _safe_target(out_root, slug)
-    if final.exists() and not final.is_dir():
-        raise PackageWriteError(f"{final} exists and is not a folder; refusing to replace it")
-    staging = Path(tempfile.mkdtemp(prefix=f".{slug}.", suffix=".tmp", dir=out_root))
+    try:
+        # -o at a file, below a file, or in a folder this user cannot write: one line, not a traceback.
+        out_root.mkdir(parents=True, exist_ok=True)
+        final = _safe_target(out_root, slug)
+        if final.exists() and not final.is_dir():
+            raise PackageWriteError(f"{final} exists and is not a folder; refusing to replace it")
+        staging = Path(tempfile.mkdtemp(prefix=f".{slug}.", suffix=".tmp", dir=out_root))
+    except OSError as exc:
+        raise PackageWriteError(f"cannot write into {out_root}: {exc.strerror or exc}") from exc
     try:
         _write_files(staging, files)
         if finish is not None:

@@ -79,12 +79,17 @@ def measure_format(params: FrostParams, fmt: str) -> FormatGate:
     return FormatGate(fmt, max(per_rate.values()), HALF_FLOAT_TOLERANCE, per_rate)
 
 
+class FormatRefusedError(Exception):
+    """No storage format holds the history to the tolerance: the build refuses (exit 3) by name."""
+
+
 def choose_format(params: FrostParams, requested: str) -> tuple[str, list[FormatGate]]:
-    """The format to ship and the gates measured on the way; ValueError if a requested format fails."""
+    """The format to ship and the gates measured on the way; FormatRefusedError when the requested format,
+    or under "auto" every format, fails its gate (a format that fails is never shipped)."""
     if requested != "auto":
         gate = measure_format(params, requested)
         if not gate.passed:
-            raise ValueError(
+            raise FormatRefusedError(
                 f"{requested} drifts {gate.drift:.3g} between 30, 60 and 120 FPS on the conformance path "
                 f'(limit {gate.threshold:.3g}); use "auto" or "rgba32float", or a faster decay'
             )
@@ -95,4 +100,8 @@ def choose_format(params: FrostParams, requested: str) -> tuple[str, list[Format
         gates.append(gate)
         if gate.passed:
             return fmt, gates
-    return FORMAT_ORDER[-1], gates
+    worst = ", ".join(f"{g.format} drifts {g.drift:.3g}" for g in gates)
+    raise FormatRefusedError(
+        f"no history storage format holds the conformance path within {gates[-1].threshold:.3g} between 30, "
+        f"60 and 120 FPS ({worst}): use a faster decay (history.visible.survivalPerSecond) or fewer substeps"
+    )

@@ -18,10 +18,18 @@ from typing import Literal
 import numpy as np
 
 from .brush import Segment, coverage, texel_noise
-from .law import Array, advance
+from .law import Array, advance, catch_up
 from .params import FrostParams
 from .schedule import BoolGrid, TilePlan, TileScheduler, diffusion_substeps
-from .timeline import Decision, Step, chunk_steps, classify_interval, split_interval, validate_segment
+from .timeline import (
+    Decision,
+    Step,
+    chunk_steps,
+    classify_interval,
+    late_steps,
+    split_interval,
+    validate_segment,
+)
 
 Storage = Literal["float16", "float32", "float64"]
 
@@ -42,6 +50,8 @@ class FrameReport:
     update_tiles: int = 0
     retired_tiles: int = 0
     substeps: int = 0
+    late_steps: int = 0
+    pointer_seconds: float = 0.0
 
 
 @dataclass
@@ -50,6 +60,7 @@ class Counters:
     discontinuities: int = 0
     dispatches: int = 0
     texels: int = 0
+    pointer_seconds: float = 0.0
     history: list[FrameReport] = field(default_factory=list)
 
 
@@ -61,6 +72,8 @@ class FrostReference:
         self.storage = storage
         self.counters = Counters()
         self.pending: list[Segment] = []
+        self.fresh_from = 0  # pending[fresh_from:] were queued since the last update
+        self.origin: float | None = None  # where the history's timeline starts (see late_steps)
         self._last_end: float | None = None
         self._allocate(width, height)
 
@@ -94,16 +107,25 @@ class FrostReference:
         if decision == "discontinuity":
             self.counters.discontinuities += 1
             self.pending = []
+            self.fresh_from = 0
+            self.origin = current
             self._last_end = None
             if self.params.discontinuity == "reset":
                 self._allocate(self.width, self.height)
             self.counters.history.append(report)
             return report
-        steps = split_interval(previous, current, self.pending)
+        if self.origin is None:
+            self.origin = previous
+        late = late_steps(previous, self.pending[self.fresh_from :], self.origin)
+        steps = late + split_interval(previous, current, self.pending)
+        report.late_steps = len(late)
+        report.pointer_seconds = sum(s.dt for s in steps if s.segment is not None)
         substeps = diffusion_substeps(self.params.diffusivity, current - previous, self.height)
         plan = self.scheduler.plan(steps, current - previous, substeps)
         self._apply(plan, steps, substeps, report, current - previous)
         self.pending = [g for g in self.pending if g.t1 > current]
+        self.fresh_from = len(self.pending)
+        self.counters.pointer_seconds += report.pointer_seconds
         self.counters.dispatches += report.dispatches
         self.counters.texels += report.texels
         self.counters.history.append(report)
@@ -155,7 +177,10 @@ class FrostReference:
                         self.thinning[index],
                     )
                     deposit[index] = np.maximum(deposit[index], b)
-                x[index] = advance(x[index], b, step.dt, channel.decay, channel.fill)
+                if step.age is None:
+                    x[index] = advance(x[index], b, step.dt, channel.decay, channel.fill)
+                else:
+                    x[index] = catch_up(x[index], b, step.dt, step.age, channel.decay, channel.fill)
         for c, value in zip((*STATE_CHANNELS, *DEPOSIT_CHANNELS), (*x, *deposit), strict=True):
             self.state[..., c] = np.where(mask, self._store(value), self.state[..., c])
 

@@ -30,10 +30,30 @@ def classify_interval(previous: float, current: float, max_interval: float) -> D
 
 @dataclass(frozen=True)
 class Step:
-    """dt seconds of constant input: ``segment`` deposits throughout, or None for pure decay."""
+    """dt seconds of constant input: ``segment`` deposits throughout, or None for pure decay.
+
+    A catch-up step (``age`` not None) is the part of a late segment that lay before ``previous``: the
+    history decayed over those dt seconds and then ``age`` more; the law's catch_up applies the deposit.
+    """
 
     dt: float
     segment: Segment | None
+    age: float | None = None
+
+
+def late_steps(previous: float, segments: list[Segment], origin: float) -> list[Step]:
+    """Catch-up steps for segments queued since the last update whose span began before ``previous``.
+
+    The missed part is [max(t0, origin), min(t1, previous)]: ``origin`` is where the history's timeline
+    starts (the first update's previous instant, or the instant a discontinuity ended), so nothing from
+    before a reset or a dropped interval is deposited. Chronological, as the segments are.
+    """
+    steps: list[Step] = []
+    for segment in segments:
+        start, end = max(segment.t0, origin), min(segment.t1, previous)
+        if end > start:
+            steps.append(Step(dt=end - start, segment=segment, age=previous - end))
+    return steps
 
 
 def split_interval(previous: float, current: float, segments: list[Segment]) -> list[Step]:

@@ -145,11 +145,13 @@ def launch_lab_page(
     *,
     timeout_s: float = 90.0,
     extra_args: tuple[str, ...] = (),
+    viewport: tuple[int, int] | None = None,
 ) -> Iterator[LabPage]:
     """Open ``url`` in a fresh headless Chromium and yield it once ``window.__lab.ready`` is true.
 
     A fresh browser per call keeps GPU state (pipeline caches, lost devices) from leaking between
-    tests; SwiftShader start-up is cheap next to shader compilation anyway.
+    tests; SwiftShader start-up is cheap next to shader compilation anyway. ``viewport`` (CSS pixels)
+    replaces Playwright's default 1280x720, e.g. for a page that sizes its canvas to the window.
     """
     console: list[str] = []
     page_errors: list[str] = []
@@ -167,7 +169,9 @@ def launch_lab_page(
                 f"could not start {executable} with {' '.join(CHROMIUM_FLAGS)}: {exc}"
             ) from exc
         try:
-            page = browser.new_page()
+            page = browser.new_page(
+                viewport=None if viewport is None else {"width": viewport[0], "height": viewport[1]}
+            )
 
             def on_console(message: ConsoleMessage) -> None:
                 console.append(f"[{message.type}] {message.text}")

@@ -28,6 +28,7 @@ from __future__ import annotations
 import base64
 import contextlib
 import json
+import math
 import time
 from collections.abc import Callable, Iterator
 from pathlib import Path
@@ -43,7 +44,7 @@ from ..creature.genome import slot_lab
 from ..creature.pose import POSE_ROWS, as_pose, pose_rows, root_rows
 from ..field import layout as col
 from ..motion.simulate import Motion
-from .browser import launch_lab_page
+from .browser import LabPage, launch_lab_page
 from .png import write_png
 from .report import ParityReport
 from .server import WEB_LAB, serve
@@ -101,6 +102,15 @@ def open_creature_lab(
 ) -> Iterator[Page]:
     """The creature lab page on ``package`` (any folder: its parent is served as /out/); ``query`` adds
     page parameters (capacity, pageSize, seed)."""
+    with open_creature_lab_page(package, canvas, **query) as lab_page:
+        yield lab_page.page
+
+
+@contextlib.contextmanager
+def open_creature_lab_page(
+    package: Path, canvas: tuple[int, int] = DEFAULT_CANVAS, **query: int
+) -> Iterator[LabPage]:
+    """open_creature_lab with the page's console transcript since launch (the parity gates read it)."""
     params = {"pkg": package.name, "w": canvas[0], "h": canvas[1], "seed": LAB_SEED, **query}
     url_path = "creature.html?" + "&".join(f"{k}={v}" for k, v in params.items())
     with (
@@ -110,7 +120,28 @@ def open_creature_lab(
         error = lab_page.lab.get("error")
         if error:
             raise RuntimeError(f"{package.name}: the lab failed to load the package: {error}")
-        yield lab_page.page
+        yield lab_page
+
+
+#: Median angle between the rendered world normal and numpy's transformed vertex normal of the nearest
+#: vertex: interpolation inside a triangle accounts for a few degrees; a wrong transform for more.
+DISPLAY_NORMAL_DEG = 3.0
+#: The adapter every parity figure is measured on (DESIGN: Chromium's WebGPU on SwiftShader); a job that
+#: ran on another adapter measured something else and must say so by failing.
+EXPECTED_ADAPTER = "swiftshader"
+
+
+def console_problems(lines: list[str]) -> list[str]:
+    """Console errors and warnings: r185 logs a failed pipeline with console.error inside an error scope
+    and skips the draw, so renderer.onError alone never sees it."""
+    return [line for line in lines if line.startswith(("[error]", "[warning]"))]
+
+
+def adapter_gate(report: ParityReport, adapter: dict[str, object]) -> None:
+    text = " ".join(str(v) for v in adapter.values() if v).lower()
+    report.gate(
+        f"adapter is {EXPECTED_ADAPTER} ({text or 'unknown'})", float(EXPECTED_ADAPTER not in text), 0, ""
+    )
 
 
 def _counter_gates(page: Page, report: ParityReport) -> None:
@@ -256,6 +287,62 @@ def _motion_gates(page: Page, ref: cref.PackageReference, motion: Motion, report
     report.measurements["feet"] = {"legs": len(feet), "planted": len(planted), "drift": feet}
 
 
+def root_transform(root: list[float], points: F64, normals: F64) -> tuple[F64, F64]:
+    """numpy's root transform (motion/simulate.py to_world_root): p + R_yaw(S·x) with S = diag(1/√s, s,
+    1/√s), and the normal by S's inverse transpose, renormalised."""
+    c, s, squash = root[3], root[4], root[5]
+    k = 1.0 / math.sqrt(squash)
+    x, y, z = points[:, 0] * k, points[:, 1] * squash, points[:, 2] * k
+    world = np.stack([c * x + s * z + root[0], y + root[1], -s * x + c * z + root[2]], axis=1)
+    q = math.sqrt(squash)
+    n = normals * np.array([q, 1.0 / squash, q])
+    n /= np.linalg.norm(n, axis=1, keepdims=True)
+    turned = np.stack([c * n[:, 0] + s * n[:, 2], n[:, 1], -s * n[:, 0] + c * n[:, 2]], axis=1)
+    return world, turned
+
+
+def _display_gates(
+    page: Page, ref: cref.PackageReference, motion: Motion, local: F64, gradient: F64, report: ParityReport
+) -> None:
+    """The display path (the shipped material's own positionNode, rendered) against numpy's root transform
+    of the drawn vertices: each covered pixel's world position must lie on the transformed mesh (within the
+    longest edge around its nearest vertices) and its normal must match the nearest vertex's."""
+    from scipy.spatial import cKDTree
+
+    shot = page.evaluate("() => window.__lab.displayPath()")
+    w, h = int(shot["width"]), int(shot["height"])
+    position = _b64_floats(shot["position"]).reshape(h * w, 4).astype(np.float64)
+    normal = _b64_floats(shot["normal"]).reshape(h * w, 4).astype(np.float64)
+    covered = position[:, 3] > 0.5
+    position[:, :3] -= float(shot["offset"])
+    normal[:, :3] -= float(shot["offset"])
+    world, turned = root_transform(
+        list(motion.root), local, gradient / np.linalg.norm(gradient, axis=1)[:, None]
+    )
+    faces = np.asarray(ref.asset.indices).reshape(-1, 3)
+    edges = np.concatenate([faces[:, [0, 1]], faces[:, [1, 2]], faces[:, [2, 0]]])
+    length = np.linalg.norm(world[edges[:, 0]] - world[edges[:, 1]], axis=1)
+    reach = np.zeros(world.shape[0])
+    np.maximum.at(reach, edges[:, 0], length)
+    np.maximum.at(reach, edges[:, 1], length)
+    pixels = position[covered, :3]
+    report.gate("display path covers body 0", float(covered.sum() == 0), 0, "empty")
+    if not covered.any():
+        return
+    distance, nearest = cKDTree(world).query(pixels, k=8)
+    off = float((distance[:, 0] / reach[nearest].max(axis=1)).max())
+    report.gate("display path world positions vs numpy's root transform", off, 1.0, "edge lengths")
+    n_px = normal[covered, :3] / np.linalg.norm(normal[covered, :3], axis=1, keepdims=True)
+    cosine = np.clip((n_px * turned[nearest[:, 0]]).sum(axis=1), -1.0, 1.0)
+    angle = np.degrees(np.arccos(cosine))
+    report.gate("display path normals vs numpy (median)", float(np.median(angle)), DISPLAY_NORMAL_DEG, "deg")
+    report.measurements["displayPath"] = {
+        "pixels": int(covered.sum()),
+        "positionOffEdgeLengths": off,
+        "normalAngleDeg": {"median": float(np.median(angle)), "p95": float(np.percentile(angle, 95))},
+    }
+
+
 def _skin_gates(page: Page, ref: cref.PackageReference, motion: Motion, report: ParityReport) -> None:
     scale = ref.rig.body_scale
     pose = as_pose(motion.quats, motion.trans)
@@ -296,6 +383,14 @@ def _skin_gates(page: Page, ref: cref.PackageReference, motion: Motion, report: 
         float(np.abs(drawn_distance - at_drawn.distance).max() / scale),
         DISTANCE_TOL,
         "L",
+    )
+    _display_gates(
+        page,
+        ref,
+        motion,
+        drawn_position,
+        _b64_floats(drawn["gradient"]).reshape(-1, 3).astype(np.float64),
+        report,
     )
     report.measurements["correction"] = {
         "region": int(region.sum()),
@@ -439,9 +534,11 @@ def run_creature_parity(
     seconds: dict[str, float] = {}
     start = time.perf_counter()
     capacity = GRID_SIDE * GRID_SIDE if "grid" in groups else PAGES_IN_BURST * PAGE_SIZE
-    with open_creature_lab(package, canvas, capacity=capacity, pageSize=PAGE_SIZE) as page:
+    with open_creature_lab_page(package, canvas, capacity=capacity, pageSize=PAGE_SIZE) as lab_page:
+        page = lab_page.page
         seconds["load"] = time.perf_counter() - start
         report.measurements["adapter"] = page.evaluate("() => window.__lab.info()")["adapter"]
+        adapter_gate(report, report.measurements["adapter"])
         report.measurements["bootMs"] = page.evaluate("() => window.__lab.bootMs")
 
         def phase(name: str, run: Callable[[], object]) -> None:
@@ -466,6 +563,9 @@ def run_creature_parity(
         errors: list[str] = page.evaluate("() => window.__lab.errors")
         report.gate("GPU validation errors", len(errors), 0, "errors")
         report.measurements["gpuErrors"] = errors[:20]
+        console = console_problems(lab_page.console) + list(lab_page.page_errors)
+        report.gate("console errors and warnings (pipeline compiles included)", len(console), 0, "lines")
+        report.measurements["consoleProblems"] = console[:20]
         report.measurements["slots"] = ref.rig.slot_count
         report.measurements["bodyScale"] = ref.rig.body_scale
         report.measurements["seconds"] = seconds

@@ -1,8 +1,11 @@
-"""A tiny static HTTP server for web_lab/ (and, later, built packages).
+"""A tiny static HTTP server for web_lab/ and the built packages it runs (mounted at ``/out/``).
 
 ES modules and import maps only work over HTTP with a JavaScript MIME type, and the system
 ``mimetypes`` table differs between machines (``.js`` is sometimes ``application/javascript``,
 ``.mjs`` is often missing), so the types are pinned here instead of guessed.
+
+``GET /packages.json`` lists the packages of the ``out`` mount (one entry per folder holding a
+``build-report.json``): the index page (web_lab/index.html, served at ``/``) is built from it.
 """
 
 from __future__ import annotations
@@ -16,6 +19,7 @@ import os
 import posixpath
 import sys
 import threading
+import urllib.parse
 from collections.abc import Iterator, Sequence
 from pathlib import Path
 from typing import Any
@@ -46,6 +50,108 @@ MIME_TYPES: dict[str, str] = {
 WEB_LAB = web_lab_dir()
 DEFAULT_HOST = "127.0.0.1"
 DEFAULT_PORT = 8765
+#: The listing of the built packages that the index page reads (see package_listing).
+LISTING_PATH = "/packages.json"
+#: Pages per package kind: the demo (public API only, for a person) and the lab page (the test harness's).
+PAGES: dict[str, dict[str, str]] = {
+    "creature": {"demo": "demo-creature.html", "lab": "creature.html"},
+    "frost": {"demo": "demo-frost.html", "lab": "frost.html"},
+}
+
+
+def _gates_passed(gates: Any) -> str | None:
+    """``"passed/total"`` over a build report's gates (creature: ``passed``; frost: ``status``)."""
+    if not isinstance(gates, list) or not gates:
+        return None
+    ok = sum(
+        1 for g in gates if isinstance(g, dict) and (g.get("passed") is True or g.get("status") == "pass")
+    )
+    return f"{ok}/{len(gates)}"
+
+
+def _section(report: dict[str, Any], key: str) -> dict[str, Any]:
+    value = report.get(key)
+    return value if isinstance(value, dict) else {}
+
+
+def _key_figures(kind: str, report: dict[str, Any], folder: Path) -> tuple[str | None, dict[str, Any]]:
+    """The tier and a few figures a person compares packages by, from one build report."""
+    figures: dict[str, Any] = {}
+    tier: Any = None
+    if kind == "creature":
+        workload = _section(report, "workload")
+        tier = report.get("tier") or workload.get("tier")
+        with contextlib.suppress(OSError, ValueError, KeyError, TypeError):
+            spec = json.loads((folder / "assets" / "spec.json").read_text(encoding="utf-8"))
+            figures["locomotion"] = spec["locomotion"]["type"]
+        for key in ("vertices", "triangles", "slots"):
+            if key in workload:
+                figures[key] = workload[key]
+    elif kind == "frost":
+        history = _section(report, "historyFormat")
+        memory = _section(report, "memory")
+        params = _section(report, "params")
+        tier = history.get("name")
+        for label, value in (
+            ("history format", history.get("historyFormat")),
+            ("history scale", params.get("historyScale")),
+            ("update policy", params.get("policy")),
+            ("history bytes at 1920x1080", memory.get("historyBytes")),
+            ("structure file bytes", memory.get("structureFileBytes")),
+        ):
+            if value is not None:
+                figures[label] = value
+    gates = _gates_passed(report.get("gates"))
+    if gates is not None:
+        figures["gates passed"] = gates
+    return (str(tier) if tier is not None else None), figures
+
+
+def package_listing(out: Path) -> list[dict[str, Any]]:
+    """One entry per built package under ``out`` (a folder with a ``build-report.json``), sorted by folder.
+
+    Links are site paths: the package's demo and lab pages (``?pkg=<folder>``) and its README under
+    ``/out/``. A folder that resolves outside ``out`` (a symlink) is left out, as the server refuses its
+    files; an unreadable report is listed with its ``error`` so the index says why it has no links.
+    """
+    root = Path(out).resolve()
+    if not root.is_dir():
+        return []
+    entries: list[dict[str, Any]] = []
+    for report_path in sorted(root.glob("*/build-report.json")):
+        folder = report_path.parent
+        if not folder.resolve().is_relative_to(root) or not report_path.resolve().is_relative_to(root):
+            continue
+        slug = folder.name
+        quoted = urllib.parse.quote(slug)
+        entry: dict[str, Any] = {"slug": slug, "readme": f"/out/{quoted}/README.md"}
+        try:
+            report = json.loads(report_path.read_text(encoding="utf-8"))
+            if not isinstance(report, dict):
+                raise ValueError("not a JSON object")
+        except (OSError, ValueError) as exc:
+            entry.update(kind=None, name=slug, error=f"unreadable build-report.json: {exc}")
+            entries.append(entry)
+            continue
+        kind = str(report.get("kind") or "")
+        tier, figures = _key_figures(kind, report, folder)
+        entry.update(
+            kind=kind or None,
+            name=report.get("name") or slug,
+            package=report.get("package") or slug,
+            version=report.get("compilerVersion"),
+            tier=tier,
+            figures=figures,
+        )
+        pages = PAGES.get(kind)
+        if pages is None:
+            entry["error"] = f"unknown package kind {kind!r}: no demo or lab page"
+        else:
+            entry.update(
+                {role: f"/{page}?pkg={urllib.parse.quote(slug, safe='')}" for role, page in pages.items()}
+            )
+        entries.append(entry)
+    return entries
 
 
 class LabRequestHandler(http.server.SimpleHTTPRequestHandler):
@@ -68,6 +174,36 @@ class LabRequestHandler(http.server.SimpleHTTPRequestHandler):
             # normpath already removed "..", but a symlink could still point outside: refuse that too.
             return str(target) if target.is_relative_to(root) else str(root / "__outside__")
         return super().translate_path(path)
+
+    def _listing(self) -> bytes | None:
+        """The body of ``GET /packages.json`` (the ``out`` mount's packages), or None for any other path."""
+        if self.path.split("?", 1)[0].split("#", 1)[0] != LISTING_PATH:
+            return None
+        out = self.mounts.get("out")
+        listing = {"packages": package_listing(out) if out is not None else []}
+        return json.dumps(listing, indent=1).encode("utf-8")
+
+    def _send_listing(self, body: bytes, *, head: bool) -> None:
+        self.send_response(http.HTTPStatus.OK)
+        self.send_header("Content-Type", MIME_TYPES[".json"])
+        self.send_header("Content-Length", str(len(body)))
+        self.end_headers()
+        if not head:
+            self.wfile.write(body)
+
+    def do_GET(self) -> None:
+        body = self._listing()
+        if body is None:
+            super().do_GET()
+        else:
+            self._send_listing(body, head=False)
+
+    def do_HEAD(self) -> None:
+        body = self._listing()
+        if body is None:
+            super().do_HEAD()
+        else:
+            self._send_listing(body, head=True)
 
     def guess_type(self, path: str | os.PathLike[str]) -> str:
         ext = posixpath.splitext(os.fspath(path))[1].lower()
@@ -142,14 +278,15 @@ def main(argv: Sequence[str] | None = None) -> int:
     server = make_server(args.root, args.host, args.port, {"out": args.out})
     base = f"http://{args.host}:{server.server_address[1]}/"
     print(f"==> serving {Path(args.root).resolve()} at {base}; packages: {Path(args.out).resolve()} at /out/")
+    print(f"    {base}  index: every built package with its demo, lab page and README")
     print(f"    {base}smoke.html  WebGPU smoke page")
-    print(f"    {base}frost.html?pkg=<slug>  a built frost package, e.g. after `make build EXAMPLE=...`")
-    print(f"    {base}creature.html?pkg=<slug>  a built creature package")
-    for report in sorted(Path(args.out).glob("*/build-report.json")):
-        kind = json.loads(report.read_text()).get("kind")
-        page = {"frost": "frost.html", "creature": "creature.html"}.get(str(kind))
-        if page:
-            print(f"    {base}{page}?pkg={report.parent.name}")
+    listing = package_listing(args.out)
+    if not listing:
+        print(f"    no built packages in {args.out} yet: `make build EXAMPLE=...`, then reload the index")
+    for entry in listing:
+        for role in ("demo", "lab"):
+            if role in entry:
+                print(f"    {base}{entry[role].lstrip('/')}  {entry['kind']} {role}")
     print("    Ctrl-C stops the server", flush=True)
     try:
         server.serve_forever()

@@ -11,8 +11,21 @@ import math
 from dataclasses import dataclass
 from typing import Any
 
+#: The longest interval a locomotion parameter may ask for (an hour): past it, or infinite, the tick
+#: counts stop being numbers a build can step (a valid ``hopHeight: 1e308`` overflowed here).
+MAX_INTERVAL_S = 3600.0
+
+
+class MotionRangeError(ValueError):
+    """A valid spec whose locomotion timing is beyond what can be stepped; the message names the fields."""
+
 
 def ticks_from_seconds(seconds: float, hz: int) -> int:
+    if not math.isfinite(seconds) or seconds > MAX_INTERVAL_S:
+        raise MotionRangeError(
+            f"locomotion: one motion interval would last {seconds:.3g} s, more than {MAX_INTERVAL_S:g} s: "
+            "lower the locomotion lengths and heights (or the scale), or raise the speed"
+        )
     return math.floor(seconds * hz + 0.5)
 
 

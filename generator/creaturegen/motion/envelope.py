@@ -56,7 +56,7 @@ from ..surface.asset import default_cache_root
 from ..surface.deform import Pose, joint_frame, quaternion_multiply, quaternion_to_matrix
 from ..surface.identity import source_digest
 from ..surface.skeleton import Skeleton, build_skeleton
-from .derived import derive
+from .derived import MotionRangeError, derive
 from .providers import AnalyticWater, FlatGround, Gravity, Support, builtin_supports
 from .rig import WALKERS, build_motion
 from .simulate import Motion
@@ -68,6 +68,9 @@ F64 = npt.NDArray[np.float64]
 #: initial plant, and both are poses a spawned instance shows.
 CYCLES: Final = 2
 MIN_SECONDS: Final = 4.0
+#: The longest cycle the envelope steps (CYCLES of it per run): a slower creature is refused by name
+#: instead of stepping for minutes (a hopper at scale 1000 hops for half a minute).
+MAX_CYCLE_S: Final = 20.0
 #: Poses of the envelope handed to the whole-body sweeps (candidate programs, skin correction), chosen
 #: by farthest-point selection over all sampled ticks, starting from the pose that moves slots most.
 SWEEP_POSES: Final = 8
@@ -174,7 +177,14 @@ def run_ticks(data: dict[str, Any]) -> int:
     """Ticks per run: CYCLES of the slowest corner individual's period (gait and size genes stretch it),
     and at least MIN_SECONDS."""
     period = max(_period(express(data, genome)) for _, genome in corner_genomes(data))
-    return max(CYCLES * period, math.ceil(MIN_SECONDS * int(data["hz"])))
+    hz = int(data["hz"])
+    if period > MAX_CYCLE_S * hz:
+        raise MotionRangeError(
+            f"locomotion: one {data['type']} cycle lasts {period / hz:.1f} s (at the slowest gene corner), "
+            f"longer than the {MAX_CYCLE_S:g} s the motion envelope measures: lower the locomotion lengths "
+            "and heights (or the scale), or raise locomotion.speed"
+        )
+    return max(CYCLES * period, math.ceil(MIN_SECONDS * hz))
 
 
 def corner_genomes(data: dict[str, Any]) -> list[tuple[str, Genome]]:

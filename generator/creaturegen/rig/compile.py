@@ -26,6 +26,56 @@ DEFAULT_K_FACTOR = 0.6
 MAX_K_BODY_FACTOR = 4.0
 
 
+#: The largest body the compiler accepts, m: every downstream figure (lattice, envelope, JSON) stays finite.
+MAX_BODY_M = 1.0e4
+#: A step or hop length or height beyond this many body sizes is no gait the envelope can measure (a
+#: valid stepHeight of 1e308 divided by zero downstream); a flea's jump is about 100 body lengths.
+MAX_STRIDE_BODY_FACTOR = 200.0
+
+
+#: The thinnest radius and blend width the compiler accepts, as a fraction of the body size: below it the
+#: blend arithmetic overflows (a valid r of 1e-300 printed numpy warnings) and no lattice resolves the part.
+MIN_BODY_FRACTION = 1.0e-4
+
+
+def _thin_errors(table: np.ndarray, slot_parts: tuple[str, ...], body: float) -> list[SpecError]:
+    """Radii and leaf blend widths of at least MIN_BODY_FRACTION of the body size, once per part."""
+    floor = MIN_BODY_FRACTION * body
+    errors: list[SpecError] = []
+    seen: set[str] = set()
+    for row, part in enumerate(slot_parts):
+        if part in seen:
+            continue
+        for field, value in (("r", min(table[row, col.RA], table[row, col.RB])), ("k", table[row, col.K])):
+            if value < floor:
+                errors.append(
+                    SpecError(
+                        f"part.{part}.{field}",
+                        f"{value:.6g} m is less than {MIN_BODY_FRACTION:g} of the body size ({body:.6g} m)",
+                    )
+                )
+                seen.add(part)
+                break
+    return errors
+
+
+def _motion_errors(spec: CharacterSpec, body: float) -> list[SpecError]:
+    """Step and hop lengths and heights within MAX_STRIDE_BODY_FACTOR body sizes (after scale)."""
+    loco = spec.locomotion
+    errors = []
+    for name in ("stepLength", "stepHeight", "hopLength", "hopHeight"):
+        value = getattr(loco, name, None) if loco is not None else None
+        if value is not None and value * spec.scale > MAX_STRIDE_BODY_FACTOR * body:
+            errors.append(
+                SpecError(
+                    f"locomotion.{name}",
+                    f"{value * spec.scale:.6g} m is more than {MAX_STRIDE_BODY_FACTOR:g}x the body size "
+                    f"({body:.6g} m)",
+                )
+            )
+    return errors
+
+
 class RigCompileError(Exception):
     """Every compile problem at once, each named like a spec error."""
 
@@ -199,7 +249,18 @@ def compile_rig(spec: CharacterSpec) -> CompiledRig:
         slot_classes.append(classes[pid][j])
 
     body = body_scale(table)
-    errors = _k_errors(graph, table[:, col.K], tuple(slot_parts), body)
+    if not math.isfinite(body) or body > MAX_BODY_M:
+        biggest = slot_parts[int(np.argmax(np.maximum(table[:, col.RA], table[:, col.RB])))]
+        raise RigCompileError(
+            [
+                SpecError(
+                    f"part.{biggest}",
+                    f"the body spans {body:.6g} m, more than {MAX_BODY_M:g} m: a smaller part or scale",
+                )
+            ]
+        )
+    errors = _k_errors(graph, table[:, col.K], tuple(slot_parts), body) + _motion_errors(spec, body)
+    errors += _thin_errors(table, tuple(slot_parts), body)
     if errors:
         raise RigCompileError(errors)
     return CompiledRig(table, tuple(slot_classes), tuple(slot_parts), graph, body)
@@ -209,4 +270,5 @@ def body_scale(slots: np.ndarray) -> float:
     """L, the largest extent of the rest AABB of all slots (their spheres included)."""
     lo = np.minimum(slots[:, col.A] - slots[:, [col.RA]], slots[:, col.B] - slots[:, [col.RB]]).min(axis=0)
     hi = np.maximum(slots[:, col.A] + slots[:, [col.RA]], slots[:, col.B] + slots[:, [col.RB]]).max(axis=0)
-    return float((hi - lo).max())
+    with np.errstate(over="ignore"):  # an infinite span is refused by name in compile_rig
+        return float((hi - lo).max())

@@ -7,6 +7,7 @@ items (wrong types are the field validator's job) and only judges what it can re
 
 from __future__ import annotations
 
+import math
 from collections import defaultdict
 from collections.abc import Iterator
 from dataclasses import dataclass, field
@@ -36,7 +37,13 @@ def _dicts(items: object) -> Iterator[tuple[int, dict[str, Any]]]:
 
 
 def _is_number(value: object) -> bool:
-    return isinstance(value, int | float) and not isinstance(value, bool)
+    """A JSON number that is a finite float (an integer literal past float range is not one)."""
+    if not isinstance(value, int | float) or isinstance(value, bool):
+        return False
+    try:
+        return math.isfinite(float(value))
+    except OverflowError:
+        return False
 
 
 def _vec3(value: object) -> tuple[float, ...] | None:
@@ -99,7 +106,8 @@ def part_fields(raw: dict[str, Any]) -> list[SpecError]:
 def parents(raw: dict[str, Any]) -> list[SpecError]:
     """Parents must exist, and the parent chain must end: a cycle has no anchor to accumulate from."""
     ids = usable_ids(raw.get("parts"))
-    every_id = {p.get("id") for _, p in _dicts(raw.get("parts"))}
+    unique = set(ids.values())
+    every_id = {p.get("id") for _, p in _dicts(raw.get("parts")) if isinstance(p.get("id"), str)}
     parent_of: dict[str, str] = {}
     errors = []
     for i, part in _dicts(raw.get("parts")):
@@ -112,27 +120,20 @@ def parents(raw: dict[str, Any]) -> list[SpecError]:
             errors.append(
                 SpecError(f"{at}.parent", f"unknown part {shown(parent)}" + did_you_mean(parent, known))
             )
-        elif i in ids and parent in ids.values():
+        elif i in ids and parent in unique:
             parent_of[ids[i]] = parent
-    reported: set[str] = set()
-    for start in sorted(parent_of):
-        chain = [start]
-        while chain[-1] in parent_of and parent_of[chain[-1]] not in chain:
-            chain.append(parent_of[chain[-1]])
-        if chain[-1] not in parent_of:
-            continue
-        cycle = chain[chain.index(parent_of[chain[-1]]) :]
-        if reported.isdisjoint(cycle):
-            reported.update(cycle)
-            loop = _rotated_loop(cycle)
-            errors.append(SpecError(f"part.{loop[0]}.parent", "parent cycle " + " -> ".join(loop)))
+    for cycle in _cycles(parent_of):
+        loop = _rotated_loop(cycle)
+        errors.append(SpecError(f"part.{loop[0]}.parent", "parent cycle " + _loop_text(loop)))
     return errors
 
 
 def locomotion(raw: dict[str, Any]) -> list[SpecError]:
     """Fields each locomotion type needs and accepts, and the leg count it drives."""
     loco = raw.get("locomotion")
-    if not isinstance(loco, dict) or loco.get("type") not in LOCOMOTION_FIELDS:
+    if not isinstance(loco, dict) or not isinstance(loco.get("type"), str):
+        return []
+    if loco["type"] not in LOCOMOTION_FIELDS:
         return []
     kind = str(loco["type"])
     needed = LOCOMOTION_FIELDS[kind]
@@ -254,17 +255,55 @@ def blend_graph(raw: dict[str, Any]) -> list[SpecError]:
     return errors + cycle_errors + _blend_reach(graph, parts, cyclic)
 
 
-def _find_cycle(graph: _BlendGraph, node: str, path: list[str]) -> list[str] | None:
-    """Depth-first search for a node-to-node cycle through ``node``; returns the cycle's nodes."""
-    if node in path:
-        return path[path.index(node) :]
-    path.append(node)
-    for kind, child in graph.children.get(node, []):
-        found = _find_cycle(graph, child, path) if kind == "node" else None
-        if found:
-            return found
-    path.pop()
-    return None
+def _node_cycles(graph: _BlendGraph) -> list[list[str]]:
+    """Node-to-node cycles met by one iterative depth-first search over every node (sorted starts), each
+    node entered once: linear in the graph, and no recursion limit for a spec with thousands of nodes."""
+    done: set[str] = set()
+    cycles: list[list[str]] = []
+    for start in sorted(graph.children):
+        if start in done:
+            continue
+        path: list[str] = [start]
+        position = {start: 0}
+        pending = [iter(graph.children.get(start, []))]
+        while pending:
+            step = next(pending[-1], None)
+            if step is None:
+                finished = path.pop()
+                del position[finished]
+                done.add(finished)
+                pending.pop()
+                continue
+            kind, child = step
+            if kind != "node" or child in done:
+                continue
+            if child in position:
+                cycles.append(path[position[child] :])
+                continue
+            position[child] = len(path)
+            path.append(child)
+            pending.append(iter(graph.children.get(child, [])))
+    return cycles
+
+
+def _cycles(parent_of: dict[str, str]) -> list[list[str]]:
+    """Every cycle of the parent map, each once, in linear time: a walk stops at the first part already
+    walked, and only a part met again within the same walk closes a cycle (a 4,000-part chain used to
+    take minutes with list membership inside the walk)."""
+    walked: set[str] = set()
+    cycles = []
+    for start in sorted(parent_of):
+        position: dict[str, int] = {}
+        path: list[str] = []
+        node: str | None = start
+        while node is not None and node not in walked:
+            position[node] = len(path)
+            path.append(node)
+            walked.add(node)
+            node = parent_of.get(node)
+        if node is not None and node in position:
+            cycles.append(path[position[node] :])
+    return cycles
 
 
 def _rotated_loop(cycle: list[str]) -> list[str]:
@@ -273,15 +312,26 @@ def _rotated_loop(cycle: list[str]) -> list[str]:
     return cycle[first:] + cycle[:first] + [cycle[first]]
 
 
+#: Members a cycle message lists before it elides the middle (a message stays one readable line).
+LOOP_SHOWN = 12
+
+
+def _loop_text(loop: list[str]) -> str:
+    """``a -> b -> a``; a long loop keeps its ends and says how many members it has."""
+    if len(loop) <= LOOP_SHOWN:
+        return " -> ".join(loop)
+    head, tail = loop[: LOOP_SHOWN - 3], loop[-2:]
+    return f"{' -> '.join(head)} -> … ({len(loop) - 1} members) -> {' -> '.join(tail)}"
+
+
 def _blend_cycles(graph: _BlendGraph) -> tuple[list[SpecError], set[str]]:
     errors = []
     cyclic: set[str] = set()
-    for start in sorted(graph.children):
-        cycle = _find_cycle(graph, start, [])
-        if cycle and cyclic.isdisjoint(cycle):
+    for cycle in _node_cycles(graph):
+        if cyclic.isdisjoint(cycle):
             cyclic.update(cycle)
             loop = _rotated_loop(cycle)
-            errors.append(SpecError(graph.node_place[loop[0]], "blend cycle " + " -> ".join(loop)))
+            errors.append(SpecError(graph.node_place[loop[0]], "blend cycle " + _loop_text(loop)))
     return errors, cyclic
 
 

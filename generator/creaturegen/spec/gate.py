@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import json
 import math
+import stat
 from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
@@ -25,6 +26,9 @@ from .types import RULE_ERROR
 
 #: Specs are ~15-250 lines; anything past this is a mistake or an attack, refused before parsing.
 MAX_SPEC_BYTES = 1 << 20
+#: Errors listed per spec: a generated spec with 70,000 unknown fields needs the first few to be fixed,
+#: not 70,000 did-you-mean searches (9 s); the rest are counted in one last line.
+MAX_ERRORS = 200
 
 Spec = CharacterSpec | FrostEffectSpec
 
@@ -120,17 +124,26 @@ def check(raw: object) -> tuple[Spec | None, list[SpecError]]:
         return None, [SpecError("kind", f"must be one of {', '.join(KINDS)} (got {shown(kind)})")]
     errors = [SpecError(place(raw, loc), message) for loc, message in _scan(raw)]
     spec: Spec | None = None
+    hidden = 0
     try:
         spec = model.model_validate(raw)
     except ValidationError as exc:
         vocabulary = _vocabulary(model)
-        for err in exc.errors(include_url=False):
+        found = exc.errors(include_url=False)
+        # Each message may search the vocabulary for a near name: only the ones that are shown are made.
+        room = max(MAX_ERRORS - len(errors), 0)
+        hidden += max(len(found) - room, 0)
+        for err in found[:room]:
             where = place(raw, err["loc"])
             message = str(err["msg"]) if err["type"] == RULE_ERROR else describe(err, vocabulary)
             errors.append(SpecError(where, message))
     if model is CharacterSpec:
         errors += check_creature(raw)
     unique = _first_per_place(errors)
+    hidden += max(len(unique) - MAX_ERRORS, 0)
+    unique = unique[:MAX_ERRORS]
+    if hidden:
+        unique.append(SpecError(WHOLE_SPEC, f"{hidden} more errors not shown; fix the ones above first"))
     return (spec if not unique else None), unique
 
 
@@ -156,11 +169,19 @@ def validate_bytes(data: bytes, source: str = "<spec>") -> Spec:
 
 
 def load_spec(path: Path) -> Spec:
-    """Read and validate a spec file."""
+    """Read and validate a spec file: a regular file, read no further than one byte past the limit (a
+    device such as /dev/zero would otherwise be read without end, a FIFO nobody writes would hang)."""
     try:
-        data = path.read_bytes()
+        info = path.stat()
+        if not stat.S_ISREG(info.st_mode):
+            raise SpecValidationError([SpecError(WHOLE_SPEC, "is not a regular file")], str(path))
+        if info.st_size > MAX_SPEC_BYTES:
+            message = f"is {info.st_size} bytes; specs are limited to {MAX_SPEC_BYTES} bytes"
+            raise SpecValidationError([SpecError(WHOLE_SPEC, message)], str(path))
+        with path.open("rb") as handle:
+            data = handle.read(MAX_SPEC_BYTES + 1)
     except OSError as exc:
         raise SpecValidationError(
-            [SpecError(WHOLE_SPEC, f"cannot be read: {exc.strerror}")], str(path)
+            [SpecError(WHOLE_SPEC, f"cannot be read: {exc.strerror or exc}")], str(path)
         ) from exc
     return validate_bytes(data, str(path))

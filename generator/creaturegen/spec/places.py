@@ -6,6 +6,7 @@ otherwise by its index (``parts[3].r``), because a bad or repeated id cannot ide
 
 from __future__ import annotations
 
+import json
 import re
 from collections import Counter
 from collections.abc import Sequence
@@ -25,12 +26,30 @@ ID_LISTS: dict[tuple[str, ...], str] = {
 UNION_TAGS = frozenset({"tree", "symmetric-nary"})
 
 _ID_RE = re.compile(ID_PATTERN)
+#: Keys shown as ``.key`` in a place; any other key is shown JSON-quoted, ``["a b"]``.
+_PLAIN_KEY = re.compile(r"[A-Za-z0-9_$-]{1,64}")
+
+
+#: usable_ids of the lists seen last, by identity: places of many errors in one list would otherwise
+#: recount its ids once per error (quadratic in a 20,000-part spec). The document is never mutated.
+_RECENT: dict[int, tuple[list[Any], dict[int, str]]] = {}
 
 
 def usable_ids(items: object) -> dict[int, str]:
     """Index -> id for list items whose id is well-formed and appears once."""
     if not isinstance(items, list):
         return {}
+    hit = _RECENT.get(id(items))
+    if hit is not None and hit[0] is items:
+        return hit[1]
+    if len(_RECENT) > 8:
+        _RECENT.clear()
+    found = _usable_ids(items)
+    _RECENT[id(items)] = (items, found)
+    return found
+
+
+def _usable_ids(items: list[Any]) -> dict[int, str]:
     ids = {i: it.get("id") for i, it in enumerate(items) if isinstance(it, dict)}
     valid = {i: v for i, v in ids.items() if isinstance(v, str) and _ID_RE.match(v)}
     counts = Counter(valid.values())
@@ -65,6 +84,11 @@ def place(raw: object, loc: Sequence[str | int]) -> str:
     for key in keys[consumed:]:
         if isinstance(key, int):
             out += f"[{key}]"
-        else:
+        elif _PLAIN_KEY.fullmatch(key):
             out += f".{key}" if out else key
+        else:
+            # A key a person could not type back (empty, spaces, control characters, markup, lone
+            # surrogates) is shown as a JSON string, so the place stays one printable ASCII line.
+            quoted = f"[{json.dumps(key, ensure_ascii=True)}]"
+            out += quoted if out else WHOLE_SPEC + quoted
     return out

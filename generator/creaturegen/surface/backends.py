@@ -59,7 +59,11 @@ def make_backend(name: str, graph: BlendGraph, slots: npt.NDArray[np.float64]) -
         from .wgpu_field import WgpuBackend
 
         return WgpuBackend(graph, slots)
-    raise ValueError(f"unknown sampling backend {name!r}; choose one of {', '.join(BACKENDS)}")
+    raise BackendChoiceError(f"unknown sampling backend {name!r}; choose one of {', '.join(BACKENDS)}")
+
+
+class BackendChoiceError(ValueError):
+    """``--backend`` names no backend: the one error the CLI attributes to that option."""
 
 
 class BackendUnavailableError(RuntimeError):

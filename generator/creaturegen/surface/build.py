@@ -28,6 +28,7 @@ from . import deform, identity
 from .asset import CachedSurface, SurfaceAsset, SurfaceCache
 from .backends import (
     BACKENDS,
+    BackendChoiceError,
     BackendUnavailableError,
     FieldBackend,
     NumpyBackend,
@@ -125,7 +126,7 @@ def choose_backend(rig: CompiledRig, requested: str, progress: Progress) -> tupl
     """The requested backend, or for "auto" the faster of numpy and wgpu measured on this machine."""
     if requested != "auto":
         if requested not in BACKENDS:
-            raise ValueError(f"--backend: unknown {requested!r}; choose auto, {', '.join(BACKENDS)}")
+            raise BackendChoiceError(f"--backend: unknown {requested!r}; choose auto, {', '.join(BACKENDS)}")
         return make_backend(requested, rig.graph, rig.slots), "requested"
     numpy_backend = NumpyBackend(rig.graph, rig.slots)
     rng = np.random.default_rng(0)

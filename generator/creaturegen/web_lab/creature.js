@@ -3,6 +3,7 @@
 // (the package's locomotion core on flat ground, analytic water for swimmers). Every GPU number it reports
 // is read back from the device (buffers or render targets). The cameras and the sun follow body 0.
 import * as THREE from 'three/webgpu';
+import { normalWorld, positionWorld, vec4 } from 'three/tsl';
 import { countDeviceCalls, countDraws, fromBase64, toBase64 } from './lab-common.js';
 
 const params = new URLSearchParams(location.search);
@@ -194,23 +195,25 @@ async function main() {
     return { size, silhouette: toBase64(silhouette), footprint: toBase64(lit) };
   }
 
+  // Three-quarter view framing body 0's posed bounds (the package README's picture, the display readback).
+  function portraitCamera() {
+    const b = pop.instance(0).bounds;
+    const centre = new THREE.Vector3((b[0] + b[3]) / 2, (b[1] + b[4]) / 2, (b[2] + b[5]) / 2);
+    const radius = 0.5 * Math.hypot(b[3] - b[0], b[4] - b[1], b[5] - b[2]);
+    const cam = camera.clone();
+    const distance = 1.15 * radius / Math.sin(THREE.MathUtils.degToRad(cam.fov / 2));
+    cam.position.copy(centre).add(new THREE.Vector3(0.62, 0.42, 0.66).normalize().multiplyScalar(distance));
+    cam.near = 0.01 * distance;
+    cam.far = 10 * distance;
+    cam.lookAt(centre);
+    cam.updateProjectionMatrix();
+    cam.updateMatrixWorld();
+    return cam;
+  }
+
   async function capturePixels(view = 'front') {
     if (view === 'front') return { view, width, height, rgba: toBase64(await renderTo(camera, width, height)) };
-    if (view === 'portrait') {
-      // Three-quarter view framing body 0's posed bounds (the package README's picture).
-      const b = pop.instance(0).bounds;
-      const centre = new THREE.Vector3((b[0] + b[3]) / 2, (b[1] + b[4]) / 2, (b[2] + b[5]) / 2);
-      const radius = 0.5 * Math.hypot(b[3] - b[0], b[4] - b[1], b[5] - b[2]);
-      const cam = camera.clone();
-      const distance = 1.15 * radius / Math.sin(THREE.MathUtils.degToRad(cam.fov / 2));
-      cam.position.copy(centre).add(new THREE.Vector3(0.62, 0.42, 0.66).normalize().multiplyScalar(distance));
-      cam.near = 0.01 * distance;
-      cam.far = 10 * distance;
-      cam.lookAt(centre);
-      cam.updateProjectionMatrix();
-      cam.updateMatrixWorld();
-      return { view, width, height, rgba: toBase64(await renderTo(cam, width, height)) };
-    }
+    if (view === 'portrait') return { view, width, height, rgba: toBase64(await renderTo(portraitCamera(), width, height)) };
     if (view === 'grid') return captureGrid();
     if (view === 'top') {
       const cam = sun.shadow.camera.clone();
@@ -249,6 +252,53 @@ async function main() {
     const rgba = await renderTo(cam, w, h);
     follow();
     return { view: 'grid', width: w, height: h, rgba: toBase64(rgba) };
+  }
+
+  // The display path itself: body 0 of page 0 drawn with the shipped material's own positionNode (the
+  // same node object, so the same root squash/yaw/position and normal transform the draw runs), writing
+  // world position and world normal into float targets from the front camera. The parity job compares
+  // them with numpy's root transform of the drawn vertices (issue 25: every other readback is taken before
+  // the root transform).
+  const DISPLAY_OFFSET = 64;
+  const displayScene = new THREE.Scene();
+  const displayProbe = { position: null, normal: null, mesh: null };
+  async function readFloatTarget(target, w, h) {
+    const padded = await renderer.readRenderTargetPixelsAsync(target, 0, 0, w, h);
+    const rowFloats = Math.ceil((w * 16) / 256) * 64;
+    const outData = new Float32Array(w * h * 4);
+    for (let y = 0; y < h; y++) outData.set(padded.subarray(y * rowFloats, y * rowFloats + w * 4), y * w * 4);
+    return outData;
+  }
+  async function displayPath() {
+    const body = pop.pages[0].mesh;
+    if (displayProbe.mesh === null || displayProbe.mesh.geometry !== body.geometry) {
+      for (const [key, value] of [['position', positionWorld], ['normal', normalWorld]]) {
+        const probe = new THREE.MeshBasicNodeMaterial();
+        probe.positionNode = body.material.positionNode;
+        // Colour outputs are clamped at 0 on the way to the target: the readback adds an offset.
+        probe.colorNode = vec4(value.add(DISPLAY_OFFSET), 1);
+        displayProbe[key] = probe;
+      }
+      displayProbe.mesh = new THREE.Mesh(body.geometry, displayProbe.position);
+      displayProbe.mesh.count = 1;
+      displayScene.add(displayProbe.mesh);
+    }
+    const target = new THREE.RenderTarget(width, height, { type: THREE.FloatType, depthBuffer: true });
+    const framing = portraitCamera();  // body 0 wherever it flies or swims
+    const result = { width, height, offset: DISPLAY_OFFSET };
+    const clearColour = renderer.getClearColor(new THREE.Color());
+    const clearAlpha = renderer.getClearAlpha();
+    renderer.setClearColor(0x000000, 0);  // alpha 0 marks pixels the body does not cover
+    for (const key of ['position', 'normal']) {
+      displayProbe.mesh.material = displayProbe[key];
+      renderer.setRenderTarget(target);
+      renderer.render(displayScene, framing);
+      renderer.setRenderTarget(null);
+      result[key] = toBase64(new Uint8Array((await readFloatTarget(target, width, height)).buffer));
+    }
+    renderer.setClearColor(clearColour, clearAlpha);
+    target.dispose();
+    return result;
   }
 
   const spawnTimes = [];
@@ -376,6 +426,7 @@ async function main() {
         distance: toBase64(new Uint8Array(r.distance.buffer)), accepted: toBase64(new Uint8Array(r.accepted.buffer)) };
     },
     capturePixels,
+    displayPath,
     shadowParity,
     render,
     async finish() { await device.queue.onSubmittedWorkDone(); return errors.length; },

@@ -1,7 +1,8 @@
 // Frost lab page: loads a built frost package from /out/<slug>/ and exposes window.__lab for the
 // Playwright harness. Paused and deterministic by default: time only moves through step()/advance(),
-// whose instants the caller chooses. (Interactive play uses requestAnimationFrame timestamps; the
-// harness never calls it.)
+// whose instants the caller chooses. play() runs the rAF loop (instants: the rAF timestamp / 1000, the
+// clock of the package's attachPointer, which wires the canvas); tests/test_frost_pointer.py drags a real
+// mouse over it with uneven frame times (play({ stallMs })) and replays the recorded log in numpy.
 import * as THREE from 'three/webgpu';
 import { Fn, float, floor, mix, mod, uv, vec3 } from 'three/tsl';
 import { countDeviceCalls, toBase64 } from './lab-common.js';
@@ -56,6 +57,16 @@ async function main() {
   let clock = 0;
   let playing = false;
   let lastInstant = null;
+  let recording = false;
+  let pointerLog = [];
+  let stalls = []; // ms of busy work per played frame, cycled: uneven frame times on purpose
+  let frameIndex = 0;
+
+  function update(previous, current) {
+    const report = effect.update(previous, current);
+    if (recording) pointerLog.push({ kind: 'update', previous, current, report });
+    return report;
+  }
 
   function render() {
     effect.render();
@@ -112,16 +123,16 @@ async function main() {
     },
     queuePointerSegment(segment) { effect.pointer(segment); },
     queuePointerSegments(segments) { segments.forEach((s) => effect.pointer(s)); return segments.length; },
-    update(previous, current) { return effect.update(previous, current); },
+    update(previous, current) { return update(previous, current); },
     step(dt, { render: draw = true } = {}) {
-      const report = effect.update(clock, clock + dt);
+      const report = update(clock, clock + dt);
       clock += dt;
       if (draw) render();
       return report;
     },
     advance(instants) {
       const reports = [];
-      for (let i = 0; i + 1 < instants.length; i++) reports.push(effect.update(instants[i], instants[i + 1]));
+      for (let i = 0; i + 1 < instants.length; i++) reports.push(update(instants[i], instants[i + 1]));
       clock = instants[instants.length - 1] ?? clock;
       return reports;
     },
@@ -198,31 +209,36 @@ async function main() {
       await device.queue.onSubmittedWorkDone();
       return { previous, scale, size: [...node.size] };
     },
-    play() { playing = true; lastInstant = null; requestAnimationFrame(loop); },
+    play({ stallMs = [] } = {}) { stalls = stallMs; frameIndex = 0; playing = true; lastInstant = null; requestAnimationFrame(loop); },
     pause() { playing = false; },
+    get playing() { return playing; },
+    get playedFrames() { return frameIndex; },
+    // The pointer log: segments attachPointer queued, updates (instants and reports) and press instants.
+    startRecording() { pointerLog = []; recording = true; },
+    stopRecording() { recording = false; return pointerLog; },
   };
 
   function loop(ms) {
     if (!playing) return;
     const now = ms / 1000;
-    if (lastInstant !== null) effect.update(lastInstant, now);
+    if (lastInstant !== null) update(lastInstant, now);
     lastInstant = now;
     render();
+    const stall = stalls.length > 0 ? stalls[frameIndex % stalls.length] : 0;
+    frameIndex += 1;
+    if (stall > 0) { const until = performance.now() + stall; while (performance.now() < until) { /* lab: uneven frames */ } }
     requestAnimationFrame(loop);
   }
 
-  // Interactive pointer input: one segment between successive samples, timestamps from the events.
-  let lastSample = null;
-  canvas.addEventListener('pointermove', (e) => {
-    if (!(e.buttons & 1)) { lastSample = null; return; }
-    const rect = canvas.getBoundingClientRect();
-    const sample = { t: e.timeStamp / 1000, uv: [(e.clientX - rect.left) / rect.width, (e.clientY - rect.top) / rect.height], p: e.pressure || 1 };
-    if (lastSample && sample.t > lastSample.t) {
-      try { effect.pointer({ t0: lastSample.t, t1: sample.t, start: lastSample.uv, end: sample.uv, pressure0: lastSample.p, pressure1: sample.p }); } catch (err) { errors.push(String(err)); }
-    }
-    lastSample = sample;
-    if (!playing) { effect.update(sample.t - 1 / 60, sample.t); render(); }
+  // Real pointer input through the package's own attachPointer (instants: event.timeStamp / 1000, the
+  // clock of the rAF loop above). While recording, every accepted segment and every update is logged in
+  // order, with the pointerdown/pointerup instants, so numpy can replay exactly what the effect received.
+  effect.attachPointer(canvas, {
+    onSegment(segment) { if (recording) pointerLog.push({ kind: 'segment', segment }); },
   });
+  const pressInstants = (event) => { if (recording) pointerLog.push({ kind: event.type, t: event.timeStamp / 1000 }); };
+  canvas.addEventListener('pointerdown', pressInstants);
+  canvas.addEventListener('pointerup', pressInstants);
   document.getElementById('play').onclick = () => (playing ? lab.pause() : lab.play());
   document.getElementById('step').onclick = () => lab.step(1 / 60);
   document.getElementById('reset').onclick = () => { lab.resetHistory(); render(); };

@@ -53,7 +53,24 @@ export function splitInterval(previous, current, segments) {
     const s0 = ordered[i];
     const s1 = ordered[i + 1];
     const active = segments.find((g) => g.t0 <= s0 && s1 <= g.t1 && g.t1 > g.t0) ?? null;
-    steps.push({ dt: s1 - s0, segment: active });
+    steps.push({ dt: s1 - s0, segment: active, age: null });
+  }
+  return steps;
+}
+
+/**
+ * Catch-up steps for segments queued since the last update whose span began before `previous` (a pointer
+ * segment is known only when its end sample arrives). The missed part [max(t0, origin), min(t1, previous)]
+ * decayed in the history; the law's catch-up applies its deposit exactly, with `age` = the decay since.
+ * Only segments[from..] are looked at (those queued since the last update).
+ */
+export function lateSteps(previous, segments, origin, from = 0) {
+  const steps = [];
+  for (let i = from; i < segments.length; i++) {
+    const g = segments[i];
+    const start = Math.max(g.t0, origin);
+    const end = Math.min(g.t1, previous);
+    if (end > start) steps.push({ dt: end - start, segment: g, age: previous - end });
   }
   return steps;
 }

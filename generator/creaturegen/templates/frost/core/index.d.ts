@@ -23,10 +23,15 @@ export interface NormalizedSegment {
 
 export type IntervalDecision = 'advance' | 'none' | 'discontinuity';
 
-/** One piecewise-constant input interval of a frame. */
+/**
+ * One piecewise-constant input interval of a frame. A catch-up step (`age` a number) is the part of a late
+ * segment that lay before the frame's previous instant: the history decayed over those `dt` seconds and
+ * `age` more, and the law's catch-up form deposits it exactly.
+ */
 export interface FrameStep {
   dt: number;
   segment: NormalizedSegment | null;
+  age: number | null;
 }
 
 export type TierName = 'full' | 'balanced' | 'budgeted';
@@ -123,6 +128,10 @@ export function pointerUV(ndcX: number, ndcY: number): [number, number];
 export function scaledSize(width: number, height: number, scale: number): [number, number];
 /** Cut [previous, current) at every segment boundary inside it. */
 export function splitInterval(previous: number, current: number, segments: readonly NormalizedSegment[]): FrameStep[];
+/** Catch-up steps: the parts [max(t0, origin), min(t1, previous)] of segments queued since the last update. */
+export function lateSteps(
+  previous: number, segments: readonly NormalizedSegment[], origin: number, from?: number,
+): FrameStep[];
 export function chunkSteps(steps: readonly FrameStep[], maxSteps: number): FrameStep[][];
 /** Substeps keeping D·(dt/n)/dx² ≤ 1/4; 0 without diffusion. */
 export function diffusionSubsteps(diffusivity: number, dt: number, height: number, stability: number): number;

@@ -2,7 +2,7 @@
 // file decoder and the three.js release check.
 export { PLAN } from './plan.js';
 export {
-  TileScheduler, chunkSteps, classifyInterval, diffusionSubsteps, normalizeSegment, pointerUV, scaledSize,
+  TileScheduler, chunkSteps, classifyInterval, diffusionSubsteps, lateSteps, normalizeSegment, pointerUV, scaledSize,
   splitInterval, validateSegment,
 } from './frost-core.js';
 export { FrostRevisionError, THREE_REVISION, checkThreeRevision } from './revision.js';

@@ -15,8 +15,8 @@ import { checkThreeRevision } from '../core/revision.js';
 import { FrostAssetError, decodeStructureFile } from '../core/structure-file.js';
 import { assetUrl } from './assets.js';
 import {
-  TileScheduler, chunkSteps, classifyInterval, diffusionSubsteps, normalizeSegment, scaledSize, splitInterval,
-  validateSegment,
+  TileScheduler, chunkSteps, classifyInterval, diffusionSubsteps, lateSteps, normalizeSegment, scaledSize,
+  splitInterval, validateSegment,
 } from '../core/frost-core.js';
 import { SeparableBlurNode } from './separable-blur.js';
 
@@ -99,6 +99,17 @@ const law = Fn(([x, b, dt, decay, fill]) => {
 }, { x: 'float', b: 'float', dt: 'float', decay: 'float', fill: 'float', return: 'float' });
 
 /**
+ * Catch-up of a late segment: x only decayed over the missed span tau and then `age` seconds; return the
+ * state had it deposited under b over tau: e^(-r·b·tau)·x + e^(-λ·age)·xEq·(1 - e^(-a·tau)), exact.
+ */
+const catchUp = Fn(([x, b, tau, age, decay, fill]) => {
+  const rb = fill.mul(b);
+  const a = decay.add(rb);
+  const gained = rb.div(max(a, float(1e-30))).mul(float(1).sub(exp(a.negate().mul(tau))));
+  return exp(rb.negate().mul(tau)).mul(x).add(exp(decay.negate().mul(age)).mul(gained));
+}, { x: 'float', b: 'float', tau: 'float', age: 'float', decay: 'float', fill: 'float', return: 'float' });
+
+/**
  * Create the effect. Async because the structure textures are fetched from the package's assets.
  * The renderer must already be initialised on a WebGPU backend: there is no WebGL path. Throws
  * FrostRevisionError outside three r185 and FrostAssetError when the structure file cannot be loaded.
@@ -129,6 +140,8 @@ export async function createFrostEffect(renderer, scene, camera, options = {}) {
   let current = 0; // index of the texture holding the latest history
   let scheduler = new TileScheduler(params, histW, histH);
   const pending = [];
+  let freshFrom = 0; // pending[freshFrom..] were queued since the last update
+  let origin = null; // where the history's timeline starts: late segments deposit nothing before it
   let lastEnd = null;
 
   const uHistW = uniform(histW, 'int');
@@ -146,7 +159,8 @@ export async function createFrostEffect(renderer, scene, camera, options = {}) {
   const uOldH = uniform(1, 'int');
 
   const maxSteps = params.maxSteps;
-  // Per step: [a.u, a.v, b.u, b.v] and [dt, pressure, hasSegment, 0]; vec4 because the CPU writes it.
+  // Per step: [a.u, a.v, b.u, b.v] and [dt, pressure, hasSegment, age]; vec4 because the CPU writes it.
+  // age >= 0 marks a catch-up step (the late part of a segment, see lateSteps), -1 an ordinary one.
   const stepBuffer = instancedArray(maxSteps * 2, 'vec4');
   const stepData = stepBuffer.value.array;
   // Fixed capacity (a storage buffer cannot grow in place): every tile of a 4096² history.
@@ -186,8 +200,12 @@ export async function createFrostEffect(renderer, scene, camera, options = {}) {
         .mul(float(1).sub(n1.mul(tilt.noise)));
       dr.assign(max(dr, br));
       da.assign(max(da, ba));
-      xr.assign(law(xr, br, info.x, float(vis.decay), float(vis.fill)));
-      xa.assign(law(xa, ba, info.x, float(tilt.decay), float(tilt.fill)));
+      const late = info.w.greaterThanEqual(0);
+      const age = max(info.w, float(0));
+      xr.assign(select(late, catchUp(xr, br, info.x, age, float(vis.decay), float(vis.fill)),
+        law(xr, br, info.x, float(vis.decay), float(vis.fill))));
+      xa.assign(select(late, catchUp(xa, ba, info.x, age, float(tilt.decay), float(tilt.fill)),
+        law(xa, ba, info.x, float(tilt.decay), float(tilt.fill))));
     });
     textureStore(dst, ivec2(ix, iy), vec4(xr, dr, da, xa));
   };
@@ -394,7 +412,7 @@ export async function createFrostEffect(renderer, scene, camera, options = {}) {
   // ---- bookkeeping -----------------------------------------------------------------------------
   const counters = {
     frames: 0, idleFrames: 0, discontinuities: 0, dispatches: 0, texelsDispatched: 0, lastFrame: null,
-    segmentsQueued: 0, segmentsRejected: 0, resizes: 0,
+    segmentsQueued: 0, segmentsRejected: 0, resizes: 0, lateSteps: 0, pointerSeconds: 0,
   };
 
   function bindComposite() {
@@ -458,7 +476,7 @@ export async function createFrostEffect(renderer, scene, camera, options = {}) {
       stepData[o + 4] = chunk[i].dt;
       stepData[o + 5] = g ? 0.5 * (g.pressure0 + g.pressure1) : 0;
       stepData[o + 6] = g ? 1 : 0;
-      stepData[o + 7] = 0;
+      stepData[o + 7] = chunk[i].age ?? -1;
     }
     stepBuffer.value.addUpdateRange(0, chunk.length * 8);
     stepBuffer.value.needsUpdate = true;
@@ -467,25 +485,41 @@ export async function createFrostEffect(renderer, scene, camera, options = {}) {
 
   function update(previousInstant, currentInstant) {
     const decision = classifyInterval(previousInstant, currentInstant, params.maxInterval);
-    const report = { decision, steps: 0, dispatches: 0, texels: 0, updateTiles: 0, retiredTiles: 0, substeps: 0 };
+    const report = {
+      decision, steps: 0, dispatches: 0, texels: 0, updateTiles: 0, retiredTiles: 0, substeps: 0, lateSteps: 0,
+      pointerSeconds: 0,
+    };
     if (decision === 'none') return report;
     counters.frames += 1;
     const before = counters.dispatches;
     if (decision === 'discontinuity') {
       counters.discontinuities += 1;
       pending.length = 0;
+      freshFrom = 0;
       lastEnd = null; // time jumped: the next segment may start anywhere
       if (params.discontinuity === 'reset') reset();
+      origin = currentInstant; // after reset(): nothing queued later deposits before the jump's end
       report.dispatches = counters.dispatches - before;
       counters.lastFrame = report;
       return report;
     }
     const frameDt = currentInstant - previousInstant;
-    const steps = splitInterval(previousInstant, currentInstant, pending);
+    if (origin === null) origin = previousInstant;
+    // Segments known only after the instant they overlap (a pointer segment arrives with its end sample)
+    // first deposit their missed part exactly, then the frame's own interval runs.
+    const late = lateSteps(previousInstant, pending, origin, freshFrom);
+    const split = splitInterval(previousInstant, currentInstant, pending);
+    const steps = late.length > 0 ? late.concat(split) : split;
+    let pointerSeconds = 0;
+    for (let i = 0; i < steps.length; i++) if (steps[i].segment !== null) pointerSeconds += steps[i].dt;
     const substeps = diffusionSubsteps(params.diffusivity, frameDt, histH, params.diffusionStability);
     const { updateCount, retireCount } = scheduler.plan(steps, frameDt, substeps);
     const tileArea = scheduler.tileWidth * scheduler.tileHeight;
-    Object.assign(report, { steps: steps.length, updateTiles: updateCount, retiredTiles: retireCount });
+    Object.assign(report, {
+      steps: steps.length, updateTiles: updateCount, retiredTiles: retireCount, lateSteps: late.length, pointerSeconds,
+    });
+    counters.lateSteps += late.length;
+    counters.pointerSeconds += pointerSeconds;
     if (retireCount > 0) {
       uploadTiles(scheduler.retire, retireCount);
       runLinear(kernels.clear, retireCount);
@@ -516,6 +550,7 @@ export async function createFrostEffect(renderer, scene, camera, options = {}) {
       counters.idleFrames += 1;
     }
     for (let i = pending.length - 1; i >= 0; i--) if (pending[i].t1 <= currentInstant) pending.splice(i, 1);
+    freshFrom = pending.length;
     bindComposite();
     report.dispatches = counters.dispatches - before;
     counters.texelsDispatched += report.texels;
@@ -533,6 +568,78 @@ export async function createFrostEffect(renderer, scene, camera, options = {}) {
     pending.push(g);
     lastEnd = g.t1;
     counters.segmentsQueued += 1;
+  }
+
+  /**
+   * Wire a real pointer: one segment between successive samples of a press (coalesced events included),
+   * captured on pointerdown, ending on pointerup/cancel. Instants are `clock(event.timeStamp)`, by default
+   * event.timeStamp / 1000: seconds on the same clock as requestAnimationFrame's timestamp / 1000, which is
+   * what the frame loop must pass to update(previous, current). Positions map to history UV through the
+   * element's bounding rect (origin top-left). Pressure: pen and touch report it; a mouse is 1 while its
+   * primary button is down; the release sample keeps the last pressure (contact lasted until then).
+   */
+  function attachPointer(element, attachOptions = {}) {
+    const clock = attachOptions.clock ?? ((timeStampMs) => timeStampMs / 1000);
+    const onSegment = attachOptions.onSegment ?? null;
+    let active = null; // pointerId of the press being drawn
+    let last = null; // { t, uv, p } of the latest sample of that press
+    const sampleOf = (event, pressure) => {
+      const rect = element.getBoundingClientRect();
+      const u = (event.clientX - rect.left) / Math.max(rect.width, 1e-9);
+      const v = (event.clientY - rect.top) / Math.max(rect.height, 1e-9);
+      return { t: clock(event.timeStamp), uv: [u, v], p: Math.min(Math.max(pressure, 0), 1) };
+    };
+    const pressureOf = (event) => (event.pointerType === 'mouse' ? 1 : event.pressure);
+    const extend = (next) => {
+      if (!(next.t > last.t)) {
+        if (next.t === last.t) last = { t: last.t, uv: next.uv, p: next.p };
+        return;
+      }
+      const segment = { t0: last.t, t1: next.t, start: last.uv, end: next.uv, pressure0: last.p, pressure1: next.p };
+      last = next;
+      try {
+        pointer(segment);
+      } catch {
+        return; // refused (counted in counters.segmentsRejected); the stroke goes on from this sample
+      }
+      if (onSegment !== null) onSegment(normalizeSegment(segment));
+    };
+    const down = (event) => {
+      if (active !== null || (event.pointerType === 'mouse' && event.button !== 0)) return;
+      active = event.pointerId;
+      last = sampleOf(event, pressureOf(event));
+      try { element.setPointerCapture(event.pointerId); } catch { /* element not connected: no capture */ }
+    };
+    const move = (event) => {
+      if (event.pointerId !== active) return;
+      const coalesced = typeof event.getCoalescedEvents === 'function' ? event.getCoalescedEvents() : [];
+      const samples = coalesced.length > 0 ? coalesced : [event];
+      for (const e of samples) extend(sampleOf(e, pressureOf(e)));
+    };
+    const up = (event) => {
+      if (event.pointerId !== active) return;
+      extend(sampleOf(event, last.p));
+      active = null;
+      last = null;
+    };
+    const previousTouchAction = element.style.touchAction;
+    element.style.touchAction = 'none'; // touch drags reach us as pointer events instead of scrolling
+    element.addEventListener('pointerdown', down);
+    element.addEventListener('pointermove', move);
+    element.addEventListener('pointerup', up);
+    element.addEventListener('pointercancel', up);
+    return function detach() {
+      element.removeEventListener('pointerdown', down);
+      element.removeEventListener('pointermove', move);
+      element.removeEventListener('pointerup', up);
+      element.removeEventListener('pointercancel', up);
+      element.style.touchAction = previousTouchAction;
+      if (active !== null) {
+        try { element.releasePointerCapture(active); } catch { /* already released */ }
+      }
+      active = null;
+      last = null;
+    };
   }
 
   function reallocate(drawingWidth, drawingHeight) {
@@ -601,6 +708,8 @@ export async function createFrostEffect(renderer, scene, camera, options = {}) {
   /** Clear the history and drop queued input (the reset policy, on request). */
   function reset() {
     pending.length = 0;
+    freshFrom = 0;
+    origin = null;
     lastEnd = null;
     scheduler = new TileScheduler(params, histW, histH);
     clearAll();
@@ -676,6 +785,7 @@ export async function createFrostEffect(renderer, scene, camera, options = {}) {
     get debugView() { return debugView(); },
     get counters() { return counters; },
     pointer,
+    attachPointer,
     update,
     render() { pipeline.render(); },
     resize,
