@@ -128,12 +128,15 @@ async function main() {
     if (!targets.has(key)) targets.set(key, new THREE.RenderTarget(w, h, { depthBuffer: true }));
     return targets.get(key);
   }
-  async function readTarget(target, w, h) {
+  // A readback's rows are padded to 256 bytes (WebGPU's bytesPerRow); `texel` is bytes per pixel (4 for
+  // RGBA8, 16 for RGBA32F), and the result is the tightly packed array of the target's own type.
+  async function readTarget(target, w, h, texel = 4) {
     const padded = await renderer.readRenderTargetPixelsAsync(target, 0, 0, w, h);
-    const rowBytes = Math.ceil((w * 4) / 256) * 256;
-    const rgba = new Uint8Array(w * h * 4);
-    for (let y = 0; y < h; y++) rgba.set(padded.subarray(y * rowBytes, y * rowBytes + w * 4), y * w * 4);
-    return rgba;
+    const row = (Math.ceil((w * texel) / 256) * 256) / padded.BYTES_PER_ELEMENT;
+    const width = (w * texel) / padded.BYTES_PER_ELEMENT;
+    const out = new padded.constructor(width * h);
+    for (let y = 0; y < h; y++) out.set(padded.subarray(y * row, y * row + width), y * width);
+    return out;
   }
   async function renderTo(cam, w, h) {
     const target = targetFor(w, h);
@@ -262,13 +265,6 @@ async function main() {
   const DISPLAY_OFFSET = 64;
   const displayScene = new THREE.Scene();
   const displayProbe = { position: null, normal: null, mesh: null };
-  async function readFloatTarget(target, w, h) {
-    const padded = await renderer.readRenderTargetPixelsAsync(target, 0, 0, w, h);
-    const rowFloats = Math.ceil((w * 16) / 256) * 64;
-    const outData = new Float32Array(w * h * 4);
-    for (let y = 0; y < h; y++) outData.set(padded.subarray(y * rowFloats, y * rowFloats + w * 4), y * w * 4);
-    return outData;
-  }
   async function displayPath() {
     const body = pop.pages[0].mesh;
     if (displayProbe.mesh === null || displayProbe.mesh.geometry !== body.geometry) {
@@ -294,7 +290,7 @@ async function main() {
       renderer.setRenderTarget(target);
       renderer.render(displayScene, framing);
       renderer.setRenderTarget(null);
-      result[key] = toBase64(new Uint8Array((await readFloatTarget(target, width, height)).buffer));
+      result[key] = toBase64(new Uint8Array((await readTarget(target, width, height, 16)).buffer));
     }
     renderer.setClearColor(clearColour, clearAlpha);
     target.dispose();

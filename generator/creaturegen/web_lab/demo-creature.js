@@ -9,7 +9,7 @@
 import * as THREE from 'three/webgpu';
 import { checker, color, mix, positionWorld, screenUV, smoothstep } from 'three/tsl';
 import { OrbitControls } from 'three/addons/controls/OrbitControls.js';
-import { toBase64 } from './lab-common.js';
+import { toBase64, watchPixelRatio } from './lab-common.js';
 
 const params = new URLSearchParams(location.search);
 const slug = params.get('pkg');
@@ -20,17 +20,6 @@ const problem = document.getElementById('problem');
 const READY_AFTER_FRAMES = 3;
 
 /** Calls back whenever devicePixelRatio changes (browser zoom, a window dragged to another screen). */
-function watchPixelRatio(callback) {
-  let query = null;
-  const arm = () => {
-    query?.removeEventListener('change', changed);
-    query = window.matchMedia(`(resolution: ${window.devicePixelRatio}dppx)`);
-    query.addEventListener('change', changed);
-  };
-  function changed() { arm(); callback(); }
-  arm();
-}
-
 async function main() {
   if (!slug) throw new Error('creature demo: add ?pkg=<slug> (a creature package folder of out/); the index at / lists them');
   document.getElementById('package').textContent = slug;

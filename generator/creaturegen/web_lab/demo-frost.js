@@ -8,7 +8,7 @@
 // capture() read the GPU back (diagnostics, never called per frame).
 import * as THREE from 'three/webgpu';
 import { checker, color, mix, positionWorld, screenUV, smoothstep } from 'three/tsl';
-import { toBase64 } from './lab-common.js';
+import { toBase64, watchPixelRatio } from './lab-common.js';
 
 const params = new URLSearchParams(location.search);
 const slug = params.get('pkg');
@@ -126,17 +126,6 @@ function wirePointer(element, effect, warnings) {
 }
 
 /** Calls back whenever devicePixelRatio changes (browser zoom, a window dragged to another screen). */
-function watchPixelRatio(callback) {
-  let query = null;
-  const arm = () => {
-    query?.removeEventListener('change', changed);
-    query = window.matchMedia(`(resolution: ${window.devicePixelRatio}dppx)`);
-    query.addEventListener('change', changed);
-  };
-  function changed() { arm(); callback(); }
-  arm();
-}
-
 async function main() {
   if (!slug) throw new Error('frost demo: add ?pkg=<slug> (a frost package folder of out/); the index at / lists them');
   document.getElementById('package').textContent = slug;

@@ -63,3 +63,16 @@ export function fromBase64(text) {
   for (let i = 0; i < bin.length; i++) bytes[i] = bin.charCodeAt(i);
   return bytes;
 }
+
+/** Calls `callback` whenever the device-pixel ratio changes (a window moved to another screen, zoom):
+ * a media query on the current ratio fires once, so it is re-armed on every change. */
+export function watchPixelRatio(callback) {
+  let query = null;
+  const arm = () => {
+    query?.removeEventListener('change', changed);
+    query = window.matchMedia(`(resolution: ${window.devicePixelRatio}dppx)`);
+    query.addEventListener('change', changed);
+  };
+  function changed() { arm(); callback(); }
+  arm();
+}
