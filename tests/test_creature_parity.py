@@ -211,8 +211,7 @@ def test_the_job_fails_on_what_the_page_logs(out_root: Path, tmp_path: Path) -> 
 
 
 def test_the_adapter_gate_fails_off_swiftshader() -> None:
-    from creaturegen.lab.creature_parity import adapter_gate
-    from creaturegen.lab.report import ParityReport
+    from creaturegen.lab.report import ParityReport, adapter_gate
 
     report = ParityReport(package="planted")
     adapter_gate(report, {"architecture": "swiftshader", "vendor": "google", "description": None})
@@ -316,3 +315,23 @@ def test_the_job_catches_corrections_outside_the_region_policy(out_root: Path, t
     report = run_creature_parity(planted, groups=("skin",))
     failed = {g["name"] for g in report.gates if g["status"] == "fail"}
     assert "corrections outside the region policy" in failed, report.summary()
+
+
+@pytest.mark.browser
+def test_debug_views_draw_their_own_pictures_and_a_dead_switch_fails(out_root: Path, tmp_path: Path) -> None:
+    """Counting PNGs cannot see a debug mode that never reaches the material: each view must differ from
+    the shipped one and be more than one colour, and a setDebugMode that keeps the shipped material fails."""
+    package = build("reference/hopper.json", out_root)
+    report = run_creature_parity(package, groups=(), debug_pictures=True)
+    assert report.passed, report.summary()
+    planted = _planted(
+        package,
+        tmp_path,
+        "population.js",
+        [("    setDebugMode(m) {\n", "    setDebugMode(m) {\n      m = 'off';\n")],
+    )
+    report = run_creature_parity(planted, groups=(), debug_pictures=True)
+    failed = {g["name"] for g in report.gates if g["status"] == "fail"}
+    assert any(name.startswith("debug views identical to the shipped view") for name in failed), (
+        report.summary()
+    )

@@ -123,3 +123,23 @@ def test_parity_job_catches_a_wrong_catch_up_of_late_segments(built: dict[str, P
     status = {g["name"]: g["status"] for g in result.gates}
     assert status["GPU vs numpy history, segments arriving late (60 FPS)"] == "fail", result.summary()
     assert status["GPU vs numpy history at 60 FPS"] == "pass", result.summary()
+
+
+@pytest.mark.browser
+def test_parity_job_catches_a_debug_view_switch_that_does_nothing(
+    built: dict[str, Path], tmp_path: Path
+) -> None:
+    # Counting the PNGs cannot see a view uniform that never reaches the shader: every view would then be
+    # a picture of the final composite, which the views gate compares against.
+    source = built["frost-budgeted"]
+    broken = tmp_path / source.name
+    shutil.copytree(source, broken)
+    effect = broken / "tsl" / "frost-effect.js"
+    text = effect.read_text()
+    assert "    uDebugView.value = index;\n" in text
+    effect.write_text(text.replace("    uDebugView.value = index;\n", "    void index;\n", 1))
+    result = run_frost_parity(broken, groups=("views",))
+    failed = [g["name"] for g in result.gates if g["status"] == "fail"]
+    assert any(name.startswith("debug views identical to the final view") for name in failed), (
+        result.summary()
+    )

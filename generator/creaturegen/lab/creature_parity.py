@@ -46,7 +46,7 @@ from ..field import layout as col
 from ..motion.simulate import Motion
 from .browser import LabPage, launch_lab_page
 from .png import write_png
-from .report import ParityReport
+from .report import ParityReport, adapter_gate, console_problems
 from .server import WEB_LAB, serve
 
 DEFAULT_CANVAS = (192, 144)
@@ -126,22 +126,6 @@ def open_creature_lab_page(
 #: Median angle between the rendered world normal and numpy's transformed vertex normal of the nearest
 #: vertex: interpolation inside a triangle accounts for a few degrees; a wrong transform for more.
 DISPLAY_NORMAL_DEG = 3.0
-#: The adapter every parity figure is measured on (DESIGN: Chromium's WebGPU on SwiftShader); a job that
-#: ran on another adapter measured something else and must say so by failing.
-EXPECTED_ADAPTER = "swiftshader"
-
-
-def console_problems(lines: list[str]) -> list[str]:
-    """Console errors and warnings: r185 logs a failed pipeline with console.error inside an error scope
-    and skips the draw, so renderer.onError alone never sees it."""
-    return [line for line in lines if line.startswith(("[error]", "[warning]"))]
-
-
-def adapter_gate(report: ParityReport, adapter: dict[str, object]) -> None:
-    text = " ".join(str(v) for v in adapter.values() if v).lower()
-    report.gate(
-        f"adapter is {EXPECTED_ADAPTER} ({text or 'unknown'})", float(EXPECTED_ADAPTER not in text), 0, ""
-    )
 
 
 def _counter_gates(page: Page, report: ParityReport) -> None:
@@ -437,17 +421,27 @@ def _shadow_gate(page: Page, package: Path, report: ParityReport) -> None:
     write_png(package / "parity" / "footprint.png", foot)
 
 
-def _pictures(page: Page, package: Path, debug: bool) -> None:
+def _pictures(page: Page, package: Path, debug: bool, report: ParityReport) -> None:
     """front.png (the README's picture); with ``debug``, the distance, normals and candidates views too
-    (each is a material variant compiled on first use, ~10 s on SwiftShader)."""
-    write_png(
-        package / "parity" / "front.png", _rgba(page.evaluate("() => window.__lab.capturePixels('front')"))
-    )
+    (each is a material variant compiled on first use, ~10 s on SwiftShader), each gated to differ from
+    the shipped view and to be more than one colour (a mode that never reaches the shader draws the body
+    as shipped; a broken one draws nothing)."""
+    front = _rgba(page.evaluate("() => window.__lab.capturePixels('front')"))
+    write_png(package / "parity" / "front.png", front)
+    same: list[str] = []
+    blank: list[str] = []
     for mode in ("distance", "normals", "candidates", "shell") if debug else ():
         page.evaluate(f"() => window.__lab.setDebugMode('{mode}')")
-        shot = page.evaluate("() => window.__lab.capturePixels('front')")
-        write_png(package / "parity" / f"debug-{mode}.png", _rgba(shot))
+        picture = _rgba(page.evaluate("() => window.__lab.capturePixels('front')"))
+        write_png(package / "parity" / f"debug-{mode}.png", picture)
+        if np.array_equal(picture, front):
+            same.append(mode)
+        if bool((picture[..., :3] == picture[0, 0, :3]).all()):
+            blank.append(mode)
     page.evaluate("() => window.__lab.setDebugMode('off')")
+    if debug:
+        report.gate(f"debug views identical to the shipped view {same}", len(same), 0, "views")
+        report.gate(f"debug views of one colour {blank}", len(blank), 0, "views")
 
 
 def _grid_gates(page: Page, ref: cref.PackageReference, package: Path, report: ParityReport) -> None:
@@ -555,7 +549,7 @@ def run_creature_parity(
         phase("skin", lambda: _skin_gates(page, ref, motion, report))
         phase("shadow", lambda: _shadow_gate(page, package, report))
         t = time.perf_counter()
-        _pictures(page, package, debug_pictures)
+        _pictures(page, package, debug_pictures, report)
         seconds["pictures"] = time.perf_counter() - t
         # Last: the grid replaces every body (instance 0 included) of the lab.
         phase("grid", lambda: _grid_gates(page, ref, package, report))

@@ -54,7 +54,7 @@ from ..rig.colour import linear_to_oklab
 from .browser import launch_lab_page
 from .frost_session import FrostLab
 from .png import write_png
-from .report import ParityReport
+from .report import ParityReport, adapter_gate, console_problems
 from .server import WEB_LAB, serve
 
 DEFAULT_CANVAS = (160, 96)
@@ -101,7 +101,7 @@ def open_lab(package: Path, canvas: tuple[int, int]) -> Iterator[FrostLab]:
         error = lab_page.lab.get("error")
         if error:
             raise RuntimeError(f"frost lab failed for {package.name}: {error}\n{lab_page.transcript()}")
-        yield FrostLab(lab_page.page)
+        yield FrostLab(lab_page.page, lab_page.console, lab_page.page_errors)
 
 
 def _history_gates(lab: FrostLab, params: FrostParams, report: ParityReport) -> None:
@@ -302,11 +302,28 @@ def _views_gate(lab: FrostLab, package: Path, report: ParityReport) -> None:
     lab.reset()
     lab.queue(conformance_segments(PICTURE_SLOWDOWN))
     lab.advance(frame_instants(60, STROKE_START + STROKE_SECONDS * PICTURE_SLOWDOWN + 0.1))
-    write_png(folder / "final.png", lab.capture("final"))
+    final = lab.capture("final")
+    write_png(folder / "final.png", final)
     warm = lab.counters()["device"]
-    views: list[str] = lab.info()["debugViews"]
+    info = lab.info()
+    views: list[str] = info["debugViews"]
+    # A refraction term the spec turns off (strength 0) is legitimately one colour in its own view.
+    refraction = info.get("refraction") or {}
+    switched_off = {f"refract{t}" for t in ("Main", "Detail") if refraction.get(f"{t.lower()}Strength") == 0}
+    same: list[str] = []
+    blank: list[str] = []
     for view in views:
-        write_png(folder / f"view-{view}.png", lab.capture(view))
+        picture = lab.capture(view)
+        write_png(folder / f"view-{view}.png", picture)
+        if view != "final" and np.array_equal(picture, final):
+            same.append(view)
+        if view not in INSTANT_VIEWS and view not in switched_off and _one_colour(picture):
+            blank.append(view)
+    # The deposit views show only the frame's own deposit, zero once the stroke has ended: seen mid-stroke.
+    lab.reset()
+    lab.queue(conformance_segments(PICTURE_SLOWDOWN))
+    lab.advance(frame_instants(60, STROKE_START + 0.5 * STROKE_SECONDS * PICTURE_SLOWDOWN))
+    blank += [view for view in INSTANT_VIEWS if view in views and _one_colour(lab.capture(view))]
     after = lab.counters()["device"]
     created = sum(
         after[k] - warm[k]
@@ -318,7 +335,18 @@ def _views_gate(lab: FrostLab, package: Path, report: ParityReport) -> None:
         )
     )
     report.gate("pipelines created while switching debug views", created, 0, "pipelines")
+    # A switch that does not reach the shader draws the default view; a broken view draws one colour.
+    report.gate(f"debug views identical to the final view {same}", len(same), 0, "views")
+    report.gate(f"debug views of one colour {blank}", len(blank), 0, "views")
     report.measurements["debugViews"] = views
+
+
+#: Views of what the current frame deposits: blank after the stroke, so they are checked during it.
+INSTANT_VIEWS = ("depositR", "depositA")
+
+
+def _one_colour(picture: npt.NDArray[np.uint8]) -> bool:
+    return bool((picture[..., :3] == picture[0, 0, :3]).all())
 
 
 #: Visible-trail gates: median OKLab ΔE (L in [0, 1]) a trail must reach, and the level it falls back under.
@@ -432,6 +460,7 @@ def run_frost_parity(
     report = ParityReport(package=package.name)
     with open_lab(package, canvas) as lab:
         report.measurements["adapter"] = lab.info()["adapter"]
+        adapter_gate(report, report.measurements["adapter"])
         if "history" in groups:
             _history_gates(lab, params, report)
         if "idle" in groups:
@@ -449,6 +478,9 @@ def run_frost_parity(
         errors = lab.gpu_errors()
         report.gate("GPU validation errors", len(errors), 0, "errors")
         report.measurements["gpuErrors"] = errors[:20]
+        console = console_problems(lab.console) + list(lab.page_errors)
+        report.gate("console errors and warnings (pipeline compiles included)", len(console), 0, "lines")
+        report.measurements["consoleProblems"] = console[:20]
         report.measurements["counters"] = lab.counters()["effect"]
     (package / "parity").mkdir(exist_ok=True)
     (package / "parity" / "report.json").write_text(

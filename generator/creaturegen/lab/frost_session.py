@@ -27,8 +27,13 @@ def segment_json(segment: Segment) -> dict[str, Any]:
 class FrostLab:
     """Thin typed wrapper over ``window.__lab`` of web_lab/frost.html."""
 
-    def __init__(self, page: Page) -> None:
+    def __init__(
+        self, page: Page, console: list[str] | None = None, page_errors: list[str] | None = None
+    ) -> None:
         self.page = page
+        # The page's console transcript since launch, appended to as the page logs (browser.LabPage).
+        self.console = console if console is not None else []
+        self.page_errors = page_errors if page_errors is not None else []
 
     def call(self, expression: str, argument: Any = None) -> Any:
         return self.page.evaluate(expression, argument)

@@ -41,3 +41,21 @@ class ParityReport:
             "gates": self.gates,
             "measurements": self.measurements,
         }
+
+
+#: The adapter every parity figure is measured on (DESIGN: Chromium's WebGPU on SwiftShader); a job that
+#: ran on another adapter measured something else and must say so by failing.
+EXPECTED_ADAPTER = "swiftshader"
+
+
+def console_problems(lines: list[str]) -> list[str]:
+    """Console errors and warnings: r185 logs a failed pipeline with console.error inside an error scope
+    and skips the draw, so renderer.onError alone never sees it."""
+    return [line for line in lines if line.startswith(("[error]", "[warning]"))]
+
+
+def adapter_gate(report: ParityReport, adapter: dict[str, object]) -> None:
+    text = " ".join(str(v) for v in adapter.values() if v).lower()
+    report.gate(
+        f"adapter is {EXPECTED_ADAPTER} ({text or 'unknown'})", float(EXPECTED_ADAPTER not in text), 0, ""
+    )

@@ -117,6 +117,7 @@ async function main() {
         historySize: effect.historySize,
         canvas: [width, height],
         debugViews: pkg.DEBUG_VIEWS,
+        refraction: pkg.PLAN.refraction ?? null,
         memory: effect.memory(),
         effectKeys: Object.keys(effect).sort(),
       };
