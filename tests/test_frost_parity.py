@@ -143,3 +143,45 @@ def test_parity_job_catches_a_debug_view_switch_that_does_nothing(
     assert any(name.startswith("debug views identical to the final view") for name in failed), (
         result.summary()
     )
+
+
+@pytest.mark.browser
+@pytest.mark.parametrize(
+    ("planted_defect", "swap", "group", "gate"),
+    [
+        (
+            "a runtime that keeps every tile live once converged",
+            ("const live = always || ", "const live = true || "),
+            "idle",
+            "dispatches per idle frame after convergence",
+        ),
+        (
+            "a runtime that remaps on resize where the spec clears",
+            ('"resizePolicy": "clear"', '"resizePolicy": "preserve-remap"'),
+            "resize",
+            "resize follows clear",
+        ),
+        (
+            "a runtime that freezes on a reversed interval where the spec resets",
+            ('"discontinuity": "reset"', '"discontinuity": "freeze"'),
+            "idle",
+            "reversed interval runs the reset policy",
+        ),
+    ],
+)
+def test_parity_job_catches_a_wrong_runtime_policy(
+    built: dict[str, Path], tmp_path: Path, planted_defect: str, swap: tuple[str, str], group: str, gate: str
+) -> None:
+    # The runtime reads its policies from its plan (numpy reads the spec's from the build report) and
+    # decides which tiles stay live in its core: a plan that says otherwise, or a core that never retires
+    # a tile, runs another policy than the one declared, and that policy's gate must fail.
+    source = built["frost-budgeted"]
+    broken = tmp_path / source.name
+    shutil.copytree(source, broken)
+    target = broken / "core" / ("frost-core.js" if swap[0].startswith("const live") else "plan.js")
+    text = target.read_text()
+    assert swap[0] in text, planted_defect
+    target.write_text(text.replace(swap[0], swap[1], 1))
+    result = run_frost_parity(broken, groups=(group,))
+    failed = [g["name"] for g in result.gates if g["status"] == "fail"]
+    assert any(name.startswith(gate) for name in failed), f"{planted_defect}: {result.summary()}"
