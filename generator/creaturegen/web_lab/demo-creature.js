@@ -9,7 +9,7 @@
 import * as THREE from 'three/webgpu';
 import { checker, color, mix, positionWorld, screenUV, smoothstep } from 'three/tsl';
 import { OrbitControls } from 'three/addons/controls/OrbitControls.js';
-import { toBase64, watchPixelRatio } from './lab-common.js';
+import { runPacedLoop, toBase64, watchPixelRatio } from './lab-common.js';
 
 const params = new URLSearchParams(location.search);
 const slug = params.get('pkg');
@@ -124,13 +124,9 @@ async function main() {
   window.addEventListener('resize', resize);
   watchPixelRatio(resize);
 
-  const device = renderer.backend.device;
-  let frames = 0;
   let last = null; // the previous frame's requestAnimationFrame timestamp (ms)
   let shownAt = -1;
   let fps = 0;
-  let markedReady = false;
-  let inFlight = 0;
   function showStatus(now) {
     const size = renderer.getDrawingBufferSize(new THREE.Vector2());
     statusLine.textContent = [
@@ -143,10 +139,7 @@ async function main() {
   }
 
   function frame(ms) {
-    // At most two frames queued on the GPU: a slow adapter skips a vsync rather than fall further behind
-    // (the next update() then covers the longer interval; the driver clamps a frame to 0.25 s).
-    if (inFlight >= 2) return;
-    inFlight += 1;
+    // A skipped vsync makes the next update() cover the longer interval (the driver clamps a frame to 0.25 s).
     const dt = last === null ? 0 : (ms - last) / 1000;
     if (dt > 0) fps = 0.9 * fps + 0.1 / Math.max(dt, 1e-3);
     last = ms;
@@ -154,30 +147,17 @@ async function main() {
     population.update(dt); // fixed 60 Hz steps, interpolated render pose
     controls.update(dt);
     renderer.render(scene, camera);
-    frames += 1;
     const now = ms / 1000;
     if (now - shownAt > 0.25) { showStatus(now); shownAt = now; }
-    const done = device.queue.onSubmittedWorkDone().then(() => { inFlight -= 1; });
-    if (frames >= READY_AFTER_FRAMES && !markedReady) {
-      markedReady = true;
-      done.then(() => { window.__lab.ready = true; });
-    }
   }
-  renderer.setAnimationLoop((ms) => {
-    try {
-      frame(ms);
-    } catch (error) {
-      renderer.setAnimationLoop(null);
-      fail(error);
-    }
-  });
+  const loop = runPacedLoop(renderer, frame, fail, READY_AFTER_FRAMES);
 
   Object.assign(window.__lab, {
     package: slug,
     count,
     bodyScale: L,
     motionType: data.motion.type,
-    frames: () => frames,
+    frames: loop.frames,
     tick: () => population.tick,
     respawns: () => respawns,
     /** The frame rendered off-screen and read back: base64 RGBA8 rows (first row first), for a test's picture. */

@@ -8,7 +8,7 @@
 // capture() read the GPU back (diagnostics, never called per frame).
 import * as THREE from 'three/webgpu';
 import { checker, color, mix, positionWorld, screenUV, smoothstep } from 'three/tsl';
-import { toBase64, watchPixelRatio } from './lab-common.js';
+import { runPacedLoop, toBase64, watchPixelRatio } from './lab-common.js';
 
 const params = new URLSearchParams(location.search);
 const slug = params.get('pkg');
@@ -164,12 +164,10 @@ async function main() {
   window.addEventListener('resize', resize);
   watchPixelRatio(resize);
 
-  let frames = 0;
   let previous = null; // the previous render instant (s), on the requestAnimationFrame clock
   let now = 0;
   let shownAt = -1;
   let fps = 0;
-  let markedReady = false;
   function showStatus() {
     const [hw, hh] = effect.historySize;
     const size = renderer.getDrawingBufferSize(new THREE.Vector2());
@@ -184,13 +182,7 @@ async function main() {
     problem.textContent = [...errors, ...warnings].slice(-3).join('\n');
   }
 
-  // At most two frames queued on the GPU: a slow adapter (a software one, a busy laptop) skips a vsync rather
-  // than fall further behind with every frame (the next update() then covers the longer interval).
-  const device = renderer.backend.device;
-  let inFlight = 0;
   function frame(ms) {
-    if (inFlight >= 2) return;
-    inFlight += 1;
     now = clock(ms);
     if (previous !== null) {
       effect.update(previous, now); // dt from two instants; a jump over 1 s runs the declared policy
@@ -199,22 +191,9 @@ async function main() {
     previous = now;
     animate(now);
     effect.render();
-    frames += 1;
     if (now - shownAt > 0.25) { showStatus(); shownAt = now; }
-    const done = device.queue.onSubmittedWorkDone().then(() => { inFlight -= 1; });
-    if (frames >= READY_AFTER_FRAMES && !markedReady) {
-      markedReady = true;
-      done.then(() => { window.__lab.ready = true; });
-    }
   }
-  renderer.setAnimationLoop((ms) => {
-    try {
-      frame(ms);
-    } catch (error) {
-      renderer.setAnimationLoop(null);
-      fail(error);
-    }
-  });
+  const loop = runPacedLoop(renderer, frame, fail, READY_AFTER_FRAMES);
 
   // Diagnostics for the headless test: GPU readbacks, never part of the frame loop.
   let captureTarget = null;
@@ -222,7 +201,7 @@ async function main() {
     package: slug,
     pointerSource,
     warnings,
-    frames: () => frames,
+    frames: loop.frames,
     instant: () => now,
     counters: () => JSON.parse(JSON.stringify(effect.counters)),
     /** R (visible thaw) of the history at UV points (origin top-left, v down), and its mean. */

@@ -76,3 +76,34 @@ export function watchPixelRatio(callback) {
   function changed() { arm(); callback(); }
   arm();
 }
+
+/**
+ * The demos' animation loop: `draw(ms)` once per animation frame with at most two frames queued on the GPU
+ * (a slow adapter, a software one or a busy laptop, skips a vsync rather than fall further behind; the
+ * next draw covers the longer interval), `window.__lab.ready` once `readyAfter` frames have finished on
+ * the GPU, and a throw stops the loop and goes to `onError`. Returns the frame counter.
+ */
+export function runPacedLoop(renderer, draw, onError, readyAfter = 3) {
+  const device = renderer.backend.device;
+  let inFlight = 0;
+  let frames = 0;
+  let marked = false;
+  renderer.setAnimationLoop((ms) => {
+    if (inFlight >= 2) return;
+    inFlight += 1;
+    try {
+      draw(ms);
+    } catch (error) {
+      renderer.setAnimationLoop(null);
+      onError(error);
+      return;
+    }
+    frames += 1;
+    const done = device.queue.onSubmittedWorkDone().then(() => { inFlight -= 1; });
+    if (frames >= readyAfter && !marked) {
+      marked = true;
+      done.then(() => { window.__lab.ready = true; });
+    }
+  });
+  return { frames: () => frames };
+}
