@@ -185,3 +185,24 @@ def test_parity_job_catches_a_wrong_runtime_policy(
     result = run_frost_parity(broken, groups=(group,))
     failed = [g["name"] for g in result.gates if g["status"] == "fail"]
     assert any(name.startswith(gate) for name in failed), f"{planted_defect}: {result.summary()}"
+
+
+@pytest.mark.browser
+def test_parity_job_holds_a_float32_history_to_its_own_tolerance(
+    built: dict[str, Path], tmp_path: Path
+) -> None:
+    # A decay rate off by 0.05 % moves an rgba32float history by ~1e-4: inside the half-float tolerance one
+    # gate used to apply to both formats, outside the float32 one (measured error ~2e-6).
+    source = built["frost-budgeted"]
+    report = json.loads((source / "build-report.json").read_text())
+    assert report["historyFormat"]["historyFormat"] == "rgba32float"
+    broken = tmp_path / source.name
+    shutil.copytree(source, broken)
+    plan = broken / "core" / "plan.js"
+    decay = report["params"]["visible"]["decay"]
+    text = plan.read_text()
+    plan.write_text(text.replace(f'"decay": {decay!r}', f'"decay": {decay * 1.0005!r}', 1))
+    result = run_frost_parity(broken, groups=("history",))
+    failed = {g["name"]: g["value"] for g in result.gates if g["status"] == "fail"}
+    assert any(name.startswith("GPU vs numpy history") for name in failed), result.summary()
+    assert all(value < 2.0**-11 for value in failed.values()), result.summary()
