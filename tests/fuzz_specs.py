@@ -135,3 +135,14 @@ def encode(doc: Any, style: int) -> bytes:
     text = json.dumps(doc, indent=2 if style == 0 else None, ensure_ascii=style == 2)
     data = text.encode("utf-8", "surrogatepass")
     return b"\xef\xbb\xbf" + data if style == 3 else data
+
+
+def unusable(path: str, message: str) -> bool:
+    """An error a person or model cannot act on: no place, control characters or line breaks, or text that
+    cannot be printed as UTF-8 (a lone surrogate)."""
+    line = f"{path}: {message}"
+    try:
+        line.encode("utf-8")
+    except UnicodeEncodeError:
+        return True
+    return not path or any(ord(c) < 32 for c in line)

@@ -33,7 +33,7 @@ from hypothesis import strategies as st  # noqa: E402
 
 from creaturegen.spec import validate_bytes  # noqa: E402
 from creaturegen.spec.errors import SpecValidationError  # noqa: E402
-from fuzz_specs import documents, encode, mutated_specs  # noqa: E402
+from fuzz_specs import documents, encode, mutated_specs, unusable  # noqa: E402
 
 SLOW_S = 2.0
 
@@ -62,13 +62,7 @@ def gate_cases(count: int, keep: Path) -> dict[str, Any]:
                 validate_bytes(data, "<fuzz>")
             except SpecValidationError as exc:
                 for e in exc.errors:
-                    line = f"{e.path}: {e.message}"
-                    try:
-                        line.encode("utf-8")
-                        usable = bool(e.path) and not any(ord(c) < 32 for c in line)
-                    except UnicodeEncodeError:
-                        usable = False
-                    if not usable:
+                    if unusable(e.path, e.message):
                         note("unnamed error", data)
             except Exception as exc:  # the failure this run exists to find
                 frame = traceback.extract_tb(exc.__traceback__)[-1]

@@ -72,8 +72,10 @@ def lab_modules(install: bool = False) -> Path | None:
         return local
     cache = Path(os.environ.get(LAB_MODULES_ENV) or Path.home() / ".cache" / "creaturegen" / "lab")
     modules = cache / "node_modules"
-    if _has_three(modules) or not install:
-        return modules if _has_three(modules) else None
+    if _has_three(modules):
+        return modules
+    if not install:
+        return None
     npm = shutil.which("npm")
     if npm is None:
         raise MissingResourceError(

@@ -51,9 +51,9 @@ def compiler_digest() -> str:
     """sha256 over the compiler's Python source and templates: what a build's outcome depends on (wider
     than surface/identity.py source_digest, which keys the surface cache by the surface's own packages)."""
     h = hashlib.sha256(__version__.encode())
-    for root in [PACKAGE_ROOT]:  # the templates ship inside it
+    for root in [PACKAGE_ROOT]:  # the templates ship inside it; the lab pages build nothing
         for path in sorted(
-            p for p in root.rglob("*") if p.is_file() and not {"__pycache__", "node_modules"} & set(p.parts)
+            p for p in root.rglob("*") if p.is_file() and not {"__pycache__", "web_lab"} & set(p.parts)
         ):
             h.update(str(path.relative_to(root)).encode())
             h.update(path.read_bytes())

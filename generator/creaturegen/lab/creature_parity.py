@@ -272,14 +272,12 @@ def _motion_gates(page: Page, ref: cref.PackageReference, motion: Motion, report
 
 
 def root_transform(root: list[float], points: F64, normals: F64) -> tuple[F64, F64]:
-    """numpy's root transform (motion/simulate.py to_world_root): p + R_yaw(S·x) with S = diag(1/√s, s,
-    1/√s), and the normal by S's inverse transpose, renormalised."""
+    """Points through the locomotion reference's own root transform (Motion.to_world_root: p + R_yaw(S·x),
+    S = diag(1/√s, s, 1/√s)); normals by S's inverse transpose and the same yaw, renormalised (the
+    reference moves no normals, so this one line of it is written here)."""
+    world = np.array([Motion.to_world_root(root, p) for p in points.tolist()], dtype=np.float64)
     c, s, squash = root[3], root[4], root[5]
-    k = 1.0 / math.sqrt(squash)
-    x, y, z = points[:, 0] * k, points[:, 1] * squash, points[:, 2] * k
-    world = np.stack([c * x + s * z + root[0], y + root[1], -s * x + c * z + root[2]], axis=1)
-    q = math.sqrt(squash)
-    n = normals * np.array([q, 1.0 / squash, q])
+    n = normals * np.array([math.sqrt(squash), 1.0 / squash, math.sqrt(squash)])
     n /= np.linalg.norm(n, axis=1, keepdims=True)
     turned = np.stack([c * n[:, 0] + s * n[:, 2], n[:, 1], -s * n[:, 0] + c * n[:, 2]], axis=1)
     return world, turned

@@ -122,7 +122,7 @@ def parents(raw: dict[str, Any]) -> list[SpecError]:
             )
         elif i in ids and parent in unique:
             parent_of[ids[i]] = parent
-    for cycle in _cycles(parent_of):
+    for cycle in _cycles({part: [parent] for part, parent in parent_of.items()}):
         loop = _rotated_loop(cycle)
         errors.append(SpecError(f"part.{loop[0]}.parent", "parent cycle " + _loop_text(loop)))
     return errors
@@ -255,54 +255,34 @@ def blend_graph(raw: dict[str, Any]) -> list[SpecError]:
     return errors + cycle_errors + _blend_reach(graph, parts, cyclic)
 
 
-def _node_cycles(graph: _BlendGraph) -> list[list[str]]:
-    """Node-to-node cycles met by one iterative depth-first search over every node (sorted starts), each
-    node entered once: linear in the graph, and no recursion limit for a spec with thousands of nodes."""
+def _cycles(successors: dict[str, list[str]]) -> list[list[str]]:
+    """The cycles met by one iterative depth-first search over every node (sorted starts), each node entered
+    once: linear in the graph (a 4,000-part parent chain took minutes with list membership inside a nested
+    walk), and no recursion limit for thousands of blend nodes. Parents and blend nodes both use it."""
     done: set[str] = set()
     cycles: list[list[str]] = []
-    for start in sorted(graph.children):
+    for start in sorted(successors):
         if start in done:
             continue
         path: list[str] = [start]
         position = {start: 0}
-        pending = [iter(graph.children.get(start, []))]
+        pending = [iter(successors.get(start, []))]
         while pending:
-            step = next(pending[-1], None)
-            if step is None:
+            child = next(pending[-1], None)
+            if child is None:
                 finished = path.pop()
                 del position[finished]
                 done.add(finished)
                 pending.pop()
                 continue
-            kind, child = step
-            if kind != "node" or child in done:
+            if child in done:
                 continue
             if child in position:
                 cycles.append(path[position[child] :])
                 continue
             position[child] = len(path)
             path.append(child)
-            pending.append(iter(graph.children.get(child, [])))
-    return cycles
-
-
-def _cycles(parent_of: dict[str, str]) -> list[list[str]]:
-    """Every cycle of the parent map, each once, in linear time: a walk stops at the first part already
-    walked, and only a part met again within the same walk closes a cycle (a 4,000-part chain used to
-    take minutes with list membership inside the walk)."""
-    walked: set[str] = set()
-    cycles = []
-    for start in sorted(parent_of):
-        position: dict[str, int] = {}
-        path: list[str] = []
-        node: str | None = start
-        while node is not None and node not in walked:
-            position[node] = len(path)
-            path.append(node)
-            walked.add(node)
-            node = parent_of.get(node)
-        if node is not None and node in position:
-            cycles.append(path[position[node] :])
+            pending.append(iter(successors.get(child, [])))
     return cycles
 
 
@@ -327,7 +307,8 @@ def _loop_text(loop: list[str]) -> str:
 def _blend_cycles(graph: _BlendGraph) -> tuple[list[SpecError], set[str]]:
     errors = []
     cyclic: set[str] = set()
-    for cycle in _node_cycles(graph):
+    nodes = {n: [c for kind, c in children if kind == "node"] for n, children in graph.children.items()}
+    for cycle in _cycles(nodes):
         if cyclic.isdisjoint(cycle):
             cyclic.update(cycle)
             loop = _rotated_loop(cycle)
