@@ -119,19 +119,23 @@ def creature_out(tmp_path_factory: pytest.TempPathFactory) -> Path:
     return shared_folder(tmp_path_factory, "creature-out")
 
 
-def build_example(name: str, out_root: Path) -> Path:
+def build_example(name: str, out_root: Path, tier: str = "hero") -> Path:
     """examples/<name> (or a ``fixtures/`` spec, see spec_file) built through the command line into
-    ``out_root`` (once per run: a worker that finds another one building it waits, then uses its package)."""
+    ``out_root`` (``out_root/<tier>`` for a tier other than hero; once per run: a worker that finds another
+    one building it waits, then uses its package)."""
     import json
 
     from creaturegen.spec import slugify
 
     spec = spec_file(name)
     slug = slugify(json.loads(spec.read_text())["name"])
+    if tier != "hero":
+        out_root = out_root / tier
+        out_root.mkdir(parents=True, exist_ok=True)
     package = out_root / slug
     with exclusive(out_root / f".{slug}.lock"):
         if not package.exists():
-            result = run_cli("build", str(spec), "-o", str(out_root))
+            result = run_cli("build", str(spec), "-o", str(out_root), "--tier", tier)
             assert result.returncode == 0, result.stdout[-2000:] + result.stderr[-4000:]
     return package
 

@@ -12,6 +12,7 @@ from conftest import EXAMPLES
 from creaturegen.candidates import CandidateSet, TierRejectedError, build_candidates, tolerances
 from creaturegen.candidates.bounds import leaf_bounds, subtree_info
 from creaturegen.candidates.program import build_program
+from creaturegen.candidates.regions import RegionSearch, Tier, search
 from creaturegen.field.floors import floors_for
 from creaturegen.field.sampler import sample_graph
 from creaturegen.motion.envelope import pose_envelope
@@ -103,18 +104,33 @@ def test_lse_tail_bounds_cover_the_measured_error() -> None:
     assert found.sweep.surface_error > 0  # the tail is real, not zero
 
 
-def test_small_tiers_are_rejected_with_the_region_and_omission_named() -> None:
-    spec, rig = _compiled(EXAMPLES / "reference" / "quadruped.json")
-    with pytest.raises(
-        TierRejectedError, match=r"^tier distant: region \[.*\] needs more than K = 4 leaves: "
-    ):
-        build_candidates(spec, rig, "distant")
+#: A capped tier of K = 4: the shipped lower tiers use the skin representation (surface/skin_tier.py) and
+#: no candidate programs, but the capped search is what a field tier with a hard K does.
+CAPPED = Tier("capped", 4, 4)
 
 
-def test_a_rigid_creature_fits_the_distant_tier() -> None:
+def _capped(path: Path) -> RegionSearch:
+    spec, rig = _compiled(path)
+    return search(rig, pose_envelope(spec, rig).slot_excursion, CAPPED, tolerances(rig))
+
+
+def test_the_lower_tiers_have_no_candidate_programs() -> None:
     spec, rig = _compiled(EXAMPLES / "reference" / "flyer.json")
-    found = build_candidates(spec, rig, "distant")
-    assert found.k_used <= 4
+    for tier in ("repeated", "distant"):
+        with pytest.raises(TierRejectedError, match=rf"^tier {tier}: skin representation"):
+            build_candidates(spec, rig, tier)
+
+
+def test_small_tiers_are_rejected_with_the_region_and_omission_named() -> None:
+    with pytest.raises(
+        TierRejectedError, match=r"^tier capped: region \[.*\] needs more than K = 4 leaves: "
+    ):
+        _capped(EXAMPLES / "reference" / "quadruped.json")
+
+
+def test_a_rigid_creature_fits_a_small_k() -> None:
+    found = _capped(EXAMPLES / "reference" / "flyer.json")
+    assert max(len(p.leaves) for p in found.programs) <= 4
 
 
 def test_the_sweep_reads_the_motion_and_the_certificates_contain_it() -> None:
@@ -171,10 +187,9 @@ def test_the_colour_certificate_bounds_the_colour_error_not_the_weight() -> None
     assert not holds_near
 
 
-def test_a_lower_tier_refusal_names_the_parts_and_the_remedy() -> None:
-    spec, rig = _compiled(EXAMPLES / "reference" / "quadruped.json")
+def test_a_capped_tier_refusal_names_the_parts_and_the_remedy() -> None:
     with pytest.raises(TierRejectedError) as caught:
-        build_candidates(spec, rig, "distant")
+        _capped(EXAMPLES / "reference" / "quadruped.json")
     message = str(caught.value)
     assert "part." in message
     assert "--tier hero" in message

@@ -112,6 +112,13 @@ def test_inspect_json_reports_slots_program_and_signatures() -> None:
     assert report["compiler"]["floors"]["k_floor"] == 1e-3 * report["bodyScale"]
 
 
+def test_inspect_says_the_lower_tiers_use_the_skin_representation() -> None:
+    done = run_cli("inspect", str(EXAMPLES / "moth.json"), "--tiers", "repeated,distant")
+    assert done.returncode == 0, done.stderr
+    for tier in ("repeated", "distant"):
+        assert f"candidates {tier}: skin: tier {tier}: skin representation" in done.stdout
+
+
 def test_inspect_rejects_an_unknown_tier() -> None:
     done = run_cli("inspect", str(EXAMPLES / "moth.json"), "--tiers", "hero,epic")
     assert done.returncode == 2

@@ -71,6 +71,65 @@ def test_every_example_passes_every_parity_gate(name: str, out_root: Path) -> No
         assert (package / "parity" / "grid.png").stat().st_size > 1000
 
 
+@pytest.mark.browser
+def test_a_lower_tier_package_passes_every_parity_gate(out_root: Path) -> None:
+    """The skin representation (surface/skin_tier.py): skin vertices are checked against numpy's skinned
+    normals and baked colours, field vertices as at the hero tier."""
+    package = build_example("reference/hopper.json", out_root, "distant")
+    report = run_creature_parity(package, groups=tuple(g for g in GATE_GROUPS if g != "grid"))
+    assert report.passed, report.summary()
+    written = json.loads((package / "parity" / "report.json").read_text())
+    names = {g["name"] for g in written["gates"]}
+    assert "drawn normal of skin-program vertices vs numpy skinned normal" in names
+    assert "drawn colour of skin-program vertices vs numpy baked colour" in names
+    counts = written["measurements"]["skinProgram"]
+    print(f"distant hopper: {counts}")
+    assert counts["vertices"] > counts["fieldVertices"] > 0
+
+
+@pytest.mark.browser
+@pytest.mark.parametrize(
+    ("swap", "gate"),
+    [
+        (
+            ("normal.assign(rotatedNormal(blend.br, n));", "normal.assign(n);"),
+            "drawn normal of skin-program vertices vs numpy skinned normal",
+        ),
+        (
+            ("c1.cross(c2).mul(n.x)", "c2.cross(c1).mul(n.x)"),
+            "drawn normal of skin-program vertices vs numpy skinned normal",
+        ),
+    ],
+)
+def test_the_job_catches_a_wrong_skin_normal(  # an unrotated normal (DQ), a cofactor out of order (LBS)
+    out_root: Path, tmp_path: Path, swap: tuple[str, str], gate: str
+) -> None:
+    package = build_example("reference/hopper.json", out_root, "distant")
+    planted = _planted(package, tmp_path, "skin.js", [swap])
+    report = run_creature_parity(planted, groups=("skin",))
+    failed = {g["name"] for g in report.gates if g["status"] == "fail"}
+    assert gate in failed, report.summary()
+
+
+@pytest.mark.browser
+def test_the_job_catches_a_baked_colour_that_drops_a_leaf(out_root: Path, tmp_path: Path) -> None:
+    package = build_example("reference/hopper.json", out_root, "distant")
+    planted = _planted(
+        package,
+        tmp_path,
+        "field.js",
+        [
+            (
+                "for (let c = 0; c < 4; c++) {\n      const w = weights",
+                "for (let c = 0; c < 3; c++) {\n      const w = weights",
+            )
+        ],
+    )
+    report = run_creature_parity(planted, groups=("skin",))
+    failed = {g["name"] for g in report.gates if g["status"] == "fail"}
+    assert "drawn colour of skin-program vertices vs numpy baked colour" in failed, report.summary()
+
+
 def _planted(package: Path, tmp_path: Path, file: str, swaps: list[tuple[str, str]]) -> Path:
     """A copy of the package with a wrong GPU formula (the Python reference is untouched)."""
     copy = tmp_path / package.name

@@ -371,8 +371,8 @@ def _inspect(args: argparse.Namespace) -> int:
     for name, value in report["signatures"].items():
         print(f"  {name} {value}")
     for tier, summary in report["candidates"].items():
-        if summary["status"] == "rejected":
-            print(f"  candidates {tier}: rejected: {summary['reason']}")
+        if summary["status"] in ("rejected", "skin"):
+            print(f"  candidates {tier}: {summary['status']}: {summary['reason']}")
         else:
             print(
                 f"  candidates {tier}: K = {summary['kUsed']} (authored {summary['kAuthored']}), "

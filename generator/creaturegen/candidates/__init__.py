@@ -28,6 +28,7 @@ __all__ = [
     "TierRejectedError",
     "build_candidates",
     "describe_candidates",
+    "skin_note",
 ]
 
 
@@ -68,9 +69,18 @@ def tolerances(rig: CompiledRig) -> Tolerances:
     )
 
 
+def skin_note(tier: str) -> str:
+    """Why a skin-represented tier has no candidate programs (the package's candidateNote)."""
+    return (
+        f"tier {tier}: skin representation, the full graph only where the skin departs (surface/skin_tier.py)"
+    )
+
+
 def build_candidates(spec: CharacterSpec, rig: CompiledRig, tier: str) -> CandidateSet:
     """Programs for every region, certified and swept; TierRejectedError names what could not be bounded."""
     chosen = TIERS[tier]
+    if chosen.skin is not None:
+        raise TierRejectedError(skin_note(tier))
     tol = tolerances(rig)
     envelope = pose_envelope(spec, rig)
     found = search(rig, envelope.slot_excursion, chosen, tol)
@@ -98,6 +108,9 @@ def describe_candidates(spec: CharacterSpec, rig: CompiledRig, tiers: tuple[str,
     """Per tier: accepted with its K, regions, certificates and sweep gates, or rejected with the reason."""
     out: dict[str, object] = {}
     for name in tiers:
+        if TIERS[name].skin is not None:
+            out[name] = {"status": "skin", "reason": skin_note(name)}
+            continue
         try:
             found = build_candidates(spec, rig, name)
         except TierRejectedError as exc:

@@ -28,10 +28,26 @@ MAX_SPLITS = 1
 
 
 @dataclass(frozen=True)
+class SkinTolerance:
+    """How far a lower tier lets a skin vertex depart from the posed field before it becomes a field
+    vertex. Colour: one just-noticeable OKLab difference (about 0.02) at the repeated tier, two at the
+    distant one. Normal: the angle whose Lambert term error stays under sin θ of the light at grazing
+    incidence and 1 − cos θ head-on (10°: 17 % and 1.5 %; 20°: 34 % and 6 %), on bodies a few dozen to a
+    few hundred pixels tall."""
+
+    normal_deg: float
+    delta_e: float
+
+
+@dataclass(frozen=True)
 class Tier:
     name: str
     k: int  # authored starting K (the seed's tier table)
     k_cap: int | None  # K may grow up to this before the tier is rejected; None: up to every slot
+    # None: every vertex evaluates its candidate program at runtime. Otherwise the skin representation
+    # (surface/skin_tier.py): only vertices the skin departs from by more than these tolerances evaluate
+    # the field, through the full graph, so the tier has no candidate programs.
+    skin: SkinTolerance | None = None
 
     def cap(self, slot_count: int) -> int:
         return slot_count if self.k_cap is None else min(self.k_cap, slot_count)
@@ -40,8 +56,8 @@ class Tier:
 #: The hero tier may keep every leaf (the full graph is always exact); the others have hard caps.
 TIERS = {
     "hero": Tier("hero", 8, None),
-    "repeated": Tier("repeated", 6, 8),
-    "distant": Tier("distant", 4, 4),
+    "repeated": Tier("repeated", 6, 8, SkinTolerance(10.0, 0.02)),
+    "distant": Tier("distant", 4, 4, SkinTolerance(20.0, 0.04)),
 }
 
 

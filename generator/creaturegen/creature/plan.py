@@ -22,7 +22,7 @@ from ..motion.rig import build_motion
 from ..rig import CompiledRig
 from ..spec import CharacterSpec, slugify
 from ..surface import correct as correction
-from ..surface.build import NO_PROGRAM, SurfaceBuild
+from ..surface.build import NO_PROGRAM, SKIN_PROGRAM, SurfaceBuild
 from ..surface.deform import METHODS
 from ..surface.skeleton import Skeleton, build_skeleton
 from .assets import asset_plan
@@ -62,6 +62,22 @@ def program_tapes(
         tapes, note = [compile_tape(p.graph, p.leaves) for p in found.programs], ""
     tapes.append(compile_tape(rig.graph))
     return tapes, note
+
+
+def _representation(field_vertices: int, vertices: int) -> str:
+    """The README's sentence on how the body is shaded (surface/skin_tier.py for the skin representation)."""
+    corrected = (
+        "locally corrected toward the smooth-min field where the build proved the skin alone misses it, and "
+    )
+    if field_vertices == vertices:
+        return corrected + "shaded with normals from the field's analytic gradient."
+    return (
+        corrected
+        + f"shaded with the field's analytic normals and colour at the {field_vertices} vertices where "
+        "the skin alone departs from the field past this tier's tolerance; the other "
+        f"{vertices - field_vertices} vertices evaluate no field (skinned normal, colour baked from the "
+        "field's colour weights at rest)."
+    )
 
 
 def program_data(tapes: list[Tape]) -> list[float]:
@@ -116,6 +132,7 @@ def build_plan(
         "programCount": len(tapes),
         "fullProgram": len(tapes) - 1,
         "noProgram": NO_PROGRAM,
+        "skinProgram": SKIN_PROGRAM,
         "registers": max(len(t) for t in tapes),
         "candidateNote": note,
         "gradientFloor": GRADIENT_FLOOR,
@@ -140,6 +157,14 @@ def build_plan(
         "water": " and `water` (required: this creature swims)" if swims else "",
     }
     corrected = int(np.count_nonzero(skin[:, 1] > 0))
+    # Leaf evaluations per body and frame: each field vertex runs its own program once at its final
+    # position (E_snap adds the correction trials of corrected vertices); a skin vertex runs none.
+    program = np.asarray(asset.candidate).astype(np.int64)
+    in_field = program != SKIN_PROGRAM
+    per_program = np.array([len(t.leaves) for t in tapes])
+    leaf_evaluations = int(
+        per_program[np.where(program[in_field] == NO_PROGRAM, len(tapes) - 1, program[in_field])].sum()
+    )
     plan: dict[str, Any] = {
         "name": spec.name,
         "slug": runtime["slug"],
@@ -155,6 +180,7 @@ def build_plan(
         "signatures": dict(surface.signatures),
         "tier": surface.tier,
         "gates": [g.as_dict() for g in surface.gates],
+        "representation": _representation(int(in_field.sum()), asset.vertex_count),
         "workload": {
             "tier": surface.tier,
             "slots": rig.slot_count,
@@ -163,6 +189,8 @@ def build_plan(
             "vertices": asset.vertex_count,
             "triangles": runtime["mesh"]["triangles"],
             "correctedVertices": corrected,
+            "fieldVertices": int(in_field.sum()),
+            "leafEvaluationsPerBody": leaf_evaluations,
             "poseBytesPerBody": runtime["maxParts"] * POSE_ROWS * 16,
             # The deform pre-pass storage (tsl/deform.js DEFORM_STRIDE vec4 per vertex).
             "deformBytesPerBody": asset.vertex_count * DEFORM_STRIDE * 16,

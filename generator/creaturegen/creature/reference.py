@@ -24,6 +24,7 @@ from ..rig import CompiledRig, compile_rig
 from ..rig.graph import Ref
 from ..spec import CharacterSpec, validate_bytes
 from ..surface.asset import SurfaceAsset, read_glb
+from ..surface.build import SKIN_PROGRAM
 from ..surface.deform import Pose, posed_slots, skin_cor, skin_dq, skin_lbs
 from ..surface.skeleton import build_skeleton
 from .assets import SPEC_PATH, surface_path
@@ -136,9 +137,11 @@ def blend_pairs(rig: CompiledRig) -> list[tuple[int, int]]:
     return pairs
 
 
-def skinned_reference(ref: PackageReference, pose: Pose, size: float = 1.0) -> F64:
-    """Each vertex skinned in float64 by its baked method (LBS, DQ or CoR), as surface/deform.py does; an
-    individual of ``size`` skins its rest vertices and centres of rotation scaled by it."""
+def skinned_vertices(ref: PackageReference, pose: Pose, size: float = 1.0) -> tuple[F64, F64]:
+    """Each vertex skinned in float64 by its baked method (LBS, DQ or CoR), as surface/deform.py does:
+    positions and the skinned rest normals (LBS by the cofactor of the blended matrix, DQ and CoR by the
+    blended rotation, unit). An individual of ``size`` skins its rest vertices and centres of rotation
+    scaled by it (a similarity: the normals do not change)."""
     asset = ref.asset
     vertices = asset.positions.astype(np.float64) * size
     normals = asset.normals.astype(np.float64)
@@ -146,16 +149,43 @@ def skinned_reference(ref: PackageReference, pose: Pose, size: float = 1.0) -> F
     weights = asset.weights.astype(np.float64)
     method = np.asarray(asset.skin)[:, 0].astype(np.int64)
     out = np.empty_like(vertices)
+    out_normals = np.empty_like(normals)
     for code in (0, 1, 2):
         rows = np.flatnonzero(method == code)
         if rows.size == 0:
             continue
         v, n, i, w = vertices[rows], normals[rows], indices[rows], weights[rows]
         if code == 0:
-            out[rows] = skin_lbs(v, n, i, w, pose).positions
+            part = skin_lbs(v, n, i, w, pose)
         elif code == 1:
-            out[rows] = skin_dq(v, n, i, w, pose).positions
+            part = skin_dq(v, n, i, w, pose)
         else:
             centres = np.asarray(asset.cor_centers)[rows].astype(np.float64) * size
-            out[rows] = skin_cor(v, n, i, w, pose, centres).positions
-    return out
+            part = skin_cor(v, n, i, w, pose, centres)
+        out[rows], out_normals[rows] = part.positions, part.normals
+    return out, out_normals
+
+
+def skinned_reference(ref: PackageReference, pose: Pose, size: float = 1.0) -> F64:
+    """Each vertex's skinned position (see :func:`skinned_vertices`)."""
+    return skinned_vertices(ref, pose, size)[0]
+
+
+def skin_program_vertices(ref: PackageReference) -> npt.NDArray[np.bool_]:
+    """(V,) the vertices that evaluate no field (candidate code SKIN_PROGRAM: a skin-represented tier)."""
+    mask: npt.NDArray[np.bool_] = np.asarray(ref.asset.candidate).astype(np.int64) == SKIN_PROGRAM
+    return mask
+
+
+def baked_colours(ref: PackageReference, seed: int) -> F64:
+    """(V, 3) each vertex's baked colour for the individual spawned from ``seed``: Σ cwᵢ·rgb(csᵢ) / Σ cwᵢ
+    over the asset's four colour slots and weights, rgb its per-slot colour (:func:`instance_colours`).
+    Zeros where the asset has no baked colours (a tier whose vertices all evaluate the field)."""
+    asset = ref.asset
+    if asset.colour_slots is None or asset.colour_weights is None:
+        return np.zeros((asset.vertex_count, 3))
+    rgb = np.asarray(instance_colours(ref, seed), dtype=np.float64)
+    slots = np.asarray(asset.colour_slots).astype(np.int64)
+    weights = np.asarray(asset.colour_weights).astype(np.float64)
+    result: F64 = np.einsum("vk,vkc->vc", weights, rgb[slots]) / weights.sum(axis=1, keepdims=True)
+    return result

@@ -8,7 +8,10 @@ Gates, all measured in the run (thresholds are relative to the body scale L wher
   at ≥ 4096 seeded points on caps, inside tapers, across blends and over the box: |Δd| and the normal
   angle (points where numpy's own float32 and float64 normals disagree by more than the tolerance sit on a
   gradient seam and are counted, not gated);
-- skinning: GPU-skinned vertex positions vs numpy LBS/DQ/CoR on the same pose;
+- skinning: GPU-skinned vertex positions vs numpy LBS/DQ/CoR on the same pose; where the tier is
+  skin-represented (vertices with program SKIN_PROGRAM evaluate no field), the drawn normal of those
+  vertices vs numpy's skinned normal and their drawn colour vs the baked colour of the individual, and the
+  field gates over the other vertices only;
 - correction: every vertex the GPU corrected is no farther from the numpy posed field than its skinned
   position, and the corrected residual is reported;
 - shadows: the silhouette seen from the sun vs the shadow footprint on the ground (the depth pass uses the
@@ -44,6 +47,7 @@ from ..creature.genome import slot_lab
 from ..creature.pose import POSE_ROWS, as_pose, pose_rows, root_rows
 from ..field import layout as col
 from ..motion.simulate import Motion
+from ..surface.build import SKIN_PROGRAM
 from .browser import LabPage, launch_lab_page
 from .png import write_png
 from .report import ParityReport, adapter_gate, console_problems
@@ -83,6 +87,8 @@ GRID_SPACING = 2.0
 GRID_TICK = 24
 #: Genome colours in the GPU rows vs Python: both round the same float64 value to float32, so exactly 0.
 COLOUR_TOL = 0.0
+#: A skin-program vertex's baked colour (four float32 slot colours blended in float32) vs numpy float64.
+SKIN_COLOUR_TOL = 1e-6
 
 F64 = npt.NDArray[np.float64]
 
@@ -359,21 +365,23 @@ def _skin_gates(page: Page, ref: cref.PackageReference, motion: Motion, report: 
         "drawn vertices (deform storage) vs the GPU body path", float(drawn_error.max()), POSITION_TOL, "L"
     )
     drawn_distance = _b64_floats(drawn["distance"]).astype(np.float64)
-    at_drawn = cref.field_at(ref, table, drawn_position, motion.size)
+    drawn_gradient = _b64_floats(drawn["gradient"]).reshape(-1, 3).astype(np.float64)
+    # A skin-represented tier: vertices whose program is SKIN_PROGRAM evaluate no field (distance 0, the
+    # skinned rest normal, the baked colour); the field gates read the others only.
+    skin_only = cref.skin_program_vertices(ref)
+    evaluating = ~skin_only
+    at_drawn = cref.field_at(ref, table, drawn_position[evaluating], motion.size)
     report.gate(
         "drawn field distance vs numpy at the drawn vertices",
-        float(np.abs(drawn_distance - at_drawn.distance).max() / scale),
+        float(np.abs(drawn_distance[evaluating] - at_drawn.distance).max() / scale)
+        if evaluating.any()
+        else 0.0,
         DISTANCE_TOL,
         "L",
     )
-    _display_gates(
-        page,
-        ref,
-        motion,
-        drawn_position,
-        _b64_floats(drawn["gradient"]).reshape(-1, 3).astype(np.float64),
-        report,
-    )
+    if skin_only.any():
+        _skin_program_gates(ref, motion, drawn, drawn_gradient, drawn_distance, skin_only, report)
+    _display_gates(page, ref, motion, drawn_position, drawn_gradient, report)
     report.measurements["correction"] = {
         "region": int(region.sum()),
         "accepted": int(accepted.sum()),
@@ -383,6 +391,63 @@ def _skin_gates(page: Page, ref: cref.PackageReference, motion: Motion, report: 
         "residualCorrectedP99L": float(np.percentile(d_corr[region], 99) / scale) if region.any() else 0.0,
         "wholeMeshMaxL": float(d_corr.max() / scale),
     }
+
+
+def _skin_program_gates(
+    ref: cref.PackageReference,
+    motion: Motion,
+    drawn: dict[str, Any],
+    drawn_gradient: F64,
+    drawn_distance: F64,
+    skin_only: npt.NDArray[np.bool_],
+    report: ParityReport,
+) -> None:
+    """The vertices that evaluate no field, as the passes draw them: the skinned rest normal (numpy's
+    skin_lbs/skin_dq/skin_cor normal by the vertex's method) and the baked colour of the individual
+    (Σ cwᵢ·rgb(csᵢ) over the asset's colour slots), and no field result stored for them."""
+    pose = as_pose(motion.quats, motion.trans)
+    _, normals = cref.skinned_vertices(ref, pose, motion.size)
+    theta = _angle_deg(drawn_gradient[skin_only], normals[skin_only])
+    report.gate(
+        "drawn normal of skin-program vertices vs numpy skinned normal",
+        float(theta.max()),
+        ANGLE_TOL_DEG,
+        "deg",
+    )
+    colour = _b64_floats(drawn["colour"]).reshape(-1, 3).astype(np.float64)
+    baked = cref.baked_colours(ref, LAB_SEED)
+    colour_error = np.abs(colour[skin_only] - baked[skin_only]).max()
+    report.gate(
+        "drawn colour of skin-program vertices vs numpy baked colour",
+        float(colour_error),
+        SKIN_COLOUR_TOL,
+        "linear rgb",
+    )
+    accepted = _b64_floats(drawn["accepted"])
+    program = _b64_floats(drawn["program"])
+    stray = (
+        (drawn_distance[skin_only] != 0.0)
+        | (accepted[skin_only] != 0.0)
+        | (program[skin_only] != SKIN_PROGRAM)
+    )
+    report.gate(
+        "skin-program vertices storing a field result (distance, correction or program)",
+        int(np.count_nonzero(stray)),
+        0,
+        "vertices",
+    )
+    report.measurements["skinProgram"] = {
+        "vertices": int(skin_only.sum()),
+        "fieldVertices": int((~skin_only).sum()),
+        "normalAngleDeg": {"max": float(theta.max()), "p99": float(np.percentile(theta, 99))},
+        "colourMaxAbs": float(colour_error),
+    }
+
+
+def _angle_deg(u: F64, v: F64) -> F64:
+    cos = (u * v).sum(1) / np.maximum(np.linalg.norm(u, axis=1) * np.linalg.norm(v, axis=1), 1e-300)
+    result: F64 = np.degrees(np.arccos(np.clip(cos, -1.0, 1.0)))
+    return result
 
 
 def shadow_mismatch(silhouette: npt.NDArray[np.bool_], footprint: npt.NDArray[np.bool_]) -> tuple[float, int]:

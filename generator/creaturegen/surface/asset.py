@@ -16,7 +16,10 @@ underscore; three.js's GLTFLoader lower-cases unknown names, so ``_SLOTS`` arriv
 - ``_RADIAL`` FLOAT VEC2: (θ around, t along) the dominant slot's axis;
 - ``_SKIN`` FLOAT VEC2: the vertex's skinning method (0 LBS, 1 DQ, 2 CoR: its joint's choice) and its
   correction trust radius in metres, 0 outside the correction region (the region policy, baked);
-- ``_COR`` FLOAT VEC3: the vertex's centre of rotation (used only where the method is CoR, else 0).
+- ``_COR`` FLOAT VEC3: the vertex's centre of rotation (used only where the method is CoR, else 0);
+- ``_COLOUR_SLOTS`` and ``_COLOUR_WEIGHTS`` FLOAT VEC4, only in a skin-represented tier (distant): the
+  four leaves of largest rest proximity-colour weight and those weights renormalised to sum 1, which
+  colour the vertices that evaluate no field (``_CANDIDATE`` = SKIN_PROGRAM, surface/build.py).
 
 Indices are UNSIGNED_SHORT when every index fits below 65535 (the value glTF reserves for primitive
 restart), UNSIGNED_INT otherwise. Per-slot rest frames are one more accessor (FLOAT MAT4, count S)
@@ -150,6 +153,8 @@ class SurfaceAsset:
     extras: dict[str, object] = field(default_factory=dict)
     skin: F32 | None = None  # (V, 2): method code (0 lbs, 1 dq, 2 cor), trust radius (0: no correction)
     cor_centers: F32 | None = None  # (V, 3): CoR centre where the method is CoR, else 0
+    colour_slots: U16 | None = None  # (V, 4): baked colour leaves (skin-represented tiers only)
+    colour_weights: F32 | None = None  # (V, 4): their weights, rows sum to 1
 
     def __post_init__(self) -> None:
         positions = _frozen(self.positions, "<f4", (None, 3), "positions")
@@ -167,6 +172,23 @@ class SurfaceAsset:
         skin = _frozen(np.zeros((v, 2)) if self.skin is None else self.skin, "<f4", (v, 2), "skin")
         cor = np.zeros((v, 3)) if self.cor_centers is None else self.cor_centers
         cor_centers = _frozen(cor, "<f4", (v, 3), "cor_centers")
+        if (self.colour_slots is None) != (self.colour_weights is None):
+            raise ValueError("colour_slots and colour_weights: both or neither")
+        colour_slots = (
+            None if self.colour_slots is None else _frozen(self.colour_slots, "<u2", (v, 4), "colour_slots")
+        )
+        colour_weights = (
+            None
+            if self.colour_weights is None
+            else _frozen(self.colour_weights, "<f4", (v, 4), "colour_weights")
+        )
+        if colour_weights is not None and colour_slots is not None:
+            if np.any(colour_weights < 0) or np.any(
+                np.abs(colour_weights.astype(np.float64).sum(axis=1) - 1.0) > WEIGHT_SUM_TOLERANCE
+            ):
+                raise ValueError("colour_weights: must be non-negative and sum to 1")
+            if int(colour_slots.max()) >= rest_frames.shape[0]:
+                raise ValueError("colour_slots: slot index out of range of rest_frames")
 
         if indices.size == 0 or indices.size % 3:
             raise ValueError(f"indices: {indices.size} is not a positive multiple of 3")
@@ -200,6 +222,8 @@ class SurfaceAsset:
             ("extras", extras),
             ("skin", skin),
             ("cor_centers", cor_centers),
+            ("colour_slots", colour_slots),
+            ("colour_weights", colour_weights),
         ):
             object.__setattr__(self, name, value)
 
@@ -225,14 +249,18 @@ class SurfaceAsset:
             "rest_frames",
             "skin",
             "cor_centers",
+            "colour_slots",
+            "colour_weights",
         )
-        return self.extras == other.extras and all(
-            getattr(self, a).dtype == getattr(other, a).dtype
-            and np.array_equal(getattr(self, a), getattr(other, a))
-            for a in arrays
-        )
+        return self.extras == other.extras and all(_same(getattr(self, a), getattr(other, a)) for a in arrays)
 
     __hash__ = None  # type: ignore[assignment]
+
+
+def _same(a: npt.NDArray[Any] | None, b: npt.NDArray[Any] | None) -> bool:
+    if a is None or b is None:
+        return a is None and b is None
+    return a.dtype == b.dtype and np.array_equal(a, b)
 
 
 # --- writing -----------------------------------------------------------------------------------------
@@ -302,6 +330,11 @@ def glb_bytes(asset: SurfaceAsset, *, name: str) -> bytes:
         "_SKIN": b.add(np.asarray(asset.skin), FLOAT, "VEC2", target=ARRAY_BUFFER),
         "_COR": b.add(np.asarray(asset.cor_centers), FLOAT, "VEC3", target=ARRAY_BUFFER),
     }
+    if asset.colour_slots is not None and asset.colour_weights is not None:
+        attributes["_COLOUR_SLOTS"] = b.add(
+            asset.colour_slots.astype(np.float32), FLOAT, "VEC4", target=ARRAY_BUFFER
+        )
+        attributes["_COLOUR_WEIGHTS"] = b.add(asset.colour_weights, FLOAT, "VEC4", target=ARRAY_BUFFER)
     index_type = UNSIGNED_SHORT if asset.vertex_count <= MAX_UINT16_VERTICES else UNSIGNED_INT
     indices = b.add(asset.indices, index_type, "SCALAR", target=ELEMENT_ARRAY_BUFFER)
     rest_frames = b.add(asset.rest_frames.reshape(-1, 16), FLOAT, "MAT4", target=None)
@@ -443,6 +476,16 @@ def parse_glb(data: bytes) -> SurfaceAsset:
             extras=document["asset"].get("extras", node_extras),
             skin=_read_accessor(document, binary, attributes["_SKIN"], "VEC2"),
             cor_centers=_read_accessor(document, binary, attributes["_COR"], "VEC3"),
+            colour_slots=(
+                _read_accessor(document, binary, attributes["_COLOUR_SLOTS"], "VEC4").astype(np.uint16)
+                if "_COLOUR_SLOTS" in attributes
+                else None
+            ),
+            colour_weights=(
+                _read_accessor(document, binary, attributes["_COLOUR_WEIGHTS"], "VEC4")
+                if "_COLOUR_WEIGHTS" in attributes
+                else None
+            ),
         )
     except GlbFormatError:
         raise

@@ -18,8 +18,9 @@ import numpy as np
 import numpy.typing as npt
 
 from .. import __version__
-from ..candidates import CandidateSet, TierRejectedError, build_candidates
+from ..candidates import TIERS, CandidateSet, TierRejectedError, build_candidates, skin_note
 from ..field import layout as col
+from ..field.floors import floors_for
 from ..motion.envelope import pose_envelope
 from ..rig import CompiledRig
 from ..rig.signatures import signatures as rig_signatures
@@ -45,8 +46,18 @@ from .handles import handle_contacts
 from .mesh import Mesh
 from .sampling import sample_band
 from .skeleton import Skeleton, build_skeleton
+from .skin_tier import (
+    SUBPIXEL_PX,
+    BakedColour,
+    Departures,
+    SkinContract,
+    baked_colour,
+    field_vertices,
+    skin_contract,
+    skin_departures,
+)
 from .topology import components
-from .weights import skin_weights
+from .weights import SkinWeights, skin_weights
 
 F64 = npt.NDArray[np.float64]
 Progress = Callable[[str], None]
@@ -78,6 +89,9 @@ SMALL_LATTICE_NODES = 2_000_000
 CALIBRATION_POINTS = 32768
 #: Candidate index written for a vertex no candidate region covers (it is never corrected).
 NO_PROGRAM = 65535
+#: Candidate index of a vertex that evaluates no field at all (a skin-represented tier, TIER_REPRESENTATION):
+#: skinned position and normal, colour from its baked colour weights.
+SKIN_PROGRAM = 65534
 
 
 class SurfaceRejectedError(Exception):
@@ -182,6 +196,12 @@ def seam(skeleton: Skeleton, weights: tuple[npt.NDArray[np.int32], F64], child: 
     return result
 
 
+def vertex_trust(rig: CompiledRig, mesh: Mesh, normals: F64, indices: npt.NDArray[np.int32]) -> F64:
+    """Each vertex's correction trust radius, from its dominant slot's radius (surface/correct.py)."""
+    owner = indices[:, 0]
+    return trust_radius(mesh, normals, np.maximum(rig.slots[owner, col.RA], rig.slots[owner, col.RB]))
+
+
 def correction_sweep(
     rig: CompiledRig,
     mesh: Mesh,
@@ -201,11 +221,14 @@ def correction_sweep(
     measured that have a candidate program (the caller gates those that have none) and the worst report
     kept. Returns (region, worst report, worst skin-only error in m, per-vertex trust radius).
     """
-    owner = weights[0][:, 0]
-    radius = np.maximum(rig.slots[owner, col.RA], rig.slots[owner, col.RB])
-    trust = trust_radius(mesh, normals, radius)
+    trust = vertex_trust(rig, mesh, normals, weights[0])
     gate = SKIN_ERROR_FACTOR * rig.body_scale
     region = np.zeros(mesh.vertex_count, dtype=bool)
+    # A joint that passed its sweep only with its seam corrected (deform.choose_deformation's remedy)
+    # relies on the correction over its whole seam.
+    for joint in choice.joints:
+        if joint.corrected:
+            region |= seam(skeleton, weights, joint.child)
     posed = []
     worst_skin = 0.0
     seams = {joint.child: seam(skeleton, weights, joint.child) for joint in choice.joints}
@@ -241,6 +264,36 @@ def correction_sweep(
     return region, worst, worst_skin, trust
 
 
+def _skin_departures(
+    rig: CompiledRig,
+    mesh: Mesh,
+    normals: F64,
+    weights: SkinWeights,
+    skeleton: Skeleton,
+    choice: deform.DeformationChoice,
+    poses: tuple[deform.Pose, ...],
+) -> tuple[BakedColour, Departures]:
+    """Baked colour weights and how far the skin alone departs from the field (surface/skin_tier.py)."""
+    k_floor = floors_for(rig.body_scale).k_floor
+    colour = baked_colour(rig, mesh.vertices, k_floor)
+    pair = (weights.indices, weights.weights)
+    seams = [seam(skeleton, pair, joint.child) for joint in choice.joints]
+    on_seam = np.logical_or.reduce([*seams, np.zeros(mesh.vertex_count, dtype=bool)])
+    departures = skin_departures(rig, mesh, normals, pair, skeleton, choice, colour, poses, k_floor, on_seam)
+    return colour, departures
+
+
+def _never_worse(report: CorrectionReport) -> SurfaceGate:
+    return SurfaceGate(
+        "correctionNeverWorse",
+        report.residual_after - report.residual_before,
+        0.0,
+        "m",
+        "max",
+        "the corrected residual may not exceed the skinned one",
+    )
+
+
 def runtime_skin(
     indices: npt.NDArray[np.int32],
     weights: F64,
@@ -260,7 +313,7 @@ def runtime_skin(
     return np.stack([method, radius], axis=1).astype(np.float32)
 
 
-def _fail_on(gates: list[SurfaceGate], where: str) -> None:
+def _fail_on(gates: list[SurfaceGate], where: str, remedy: str = "") -> None:
     failed = [g for g in gates if not g.passed]
     if failed:
         g = failed[0]
@@ -268,8 +321,17 @@ def _fail_on(gates: list[SurfaceGate], where: str) -> None:
         detail = f": {g.detail}" if g.detail else ""
         raise SurfaceRejectedError(
             f"{where}: gate {g.name} = {g.value:.4g} {g.unit}, "
-            f"threshold {g.threshold:.4g} ({g.direction}){detail}{more}"
+            f"threshold {g.threshold:.4g} ({g.direction}){detail}{more}{remedy}"
         )
+
+
+def _mesh_remedy(refinement: int, spacing: float) -> str:
+    """What the build tried for a mesh gate, and what the user can change (the gate names the place)."""
+    return (
+        f"; tried {refinement + 1} lattices, the finest at h = {spacing:.3g} m: a feature there is thinner "
+        "or tighter than the lattice resolves; thicken the part named, or widen the blend k (or the gap) "
+        "where it meets its neighbour"
+    )
 
 
 def surface_mesh_gates(
@@ -536,7 +598,7 @@ def _extract_surface(
     if policy.detached:
         progress(f"declared: {', '.join(policy.detached)} detached from the body (the field leaves a gap)")
     if strict:
-        _fail_on(gates, f"surface {tier}")
+        _fail_on(gates, f"surface {tier}", _mesh_remedy(refinement, grid.spacing))
 
     t = time.perf_counter()
     weights = skin_weights(mesh, rest_field, skeleton, still=envelope.still_joints(rig.body_scale))
@@ -558,6 +620,17 @@ def _extract_surface(
         rig.body_scale,
         limits={j.child: envelope.sweep_limits(j.child) for j in envelope.joints},
         limits_from="motion envelope (motion/envelope.py), widened by its margins",
+        corrector=deform.seam_corrector(
+            mesh,
+            ex.normals,
+            rig.slots,
+            rig.graph,
+            vertex_trust(rig, mesh, ex.normals, weights.indices),
+            SKIN_ERROR_FACTOR * rig.body_scale,
+            skeleton,
+            weights.indices.astype(np.int64),
+            weights.weights,
+        ),
     )
     timings["deformation"] = time.perf_counter() - t
     for joint in choice.joints:
@@ -576,38 +649,73 @@ def _extract_surface(
     progress(f"deformation per joint: {counts} in {timings['deformation']:.2f} s")
 
     t = time.perf_counter()
-    found = tier_candidates(spec, rig, tier)
-    programs, candidate_note = candidate_index(found, mesh.vertices)
-    region, report, worst_skin, trust = correction_sweep(
-        rig, mesh, ex.normals, (weights.indices, weights.weights), skeleton, choice, programs, envelope.poses
-    )
-    timings["correction"] = time.perf_counter() - t
-    correction_gates = [
-        SurfaceGate(
-            "correctionNeverWorse",
-            report.residual_after - report.residual_before,
-            0.0,
-            "m",
-            "max",
-            "the corrected residual may not exceed the skinned one",
-        ),
-        SurfaceGate(
-            "correctionUncovered",
-            float(np.count_nonzero(region & (programs == NO_PROGRAM))),
-            0.0,
-            "vertices",
-            "max",
-            candidate_note or "region vertices outside every candidate region",
-        ),
-    ]
+    found: CandidateSet | str
+    colour: BakedColour | None = None
+    contract: SkinContract | None = None
+    skin_tol = TIERS[tier].skin
+    if skin_tol is not None:
+        colour, departures = _skin_departures(
+            rig, mesh, ex.normals, weights, skeleton, choice, envelope.poses
+        )
+        found = candidate_note = skin_note(tier)
+        # Every vertex may be corrected through the tier's one program (the full graph, index 0) ...
+        region, report, worst_skin, trust = correction_sweep(
+            rig,
+            mesh,
+            ex.normals,
+            (weights.indices, weights.weights),
+            skeleton,
+            choice,
+            np.zeros(mesh.vertex_count, dtype=np.int64),
+            envelope.poses,
+        )
+        # ... and those the skin carries within the tier's tolerances evaluate nothing at all.
+        in_field = region | field_vertices(departures, SKIN_ERROR_FACTOR * rig.body_scale, skin_tol)
+        programs = np.where(in_field, 0, SKIN_PROGRAM).astype(np.int64)
+        contract = skin_contract(departures, in_field, weights.indices[:, 0], rig, colour)
+        timings["correction"] = time.perf_counter() - t
+        correction_gates = [_never_worse(report)]
+        progress(
+            f"skin representation: {contract.field_vertices:,} of {contract.vertices:,} vertices evaluate "
+            f"the field (correction region {int(region.sum()):,}); skin vertices depart at most "
+            f"{contract.error / rig.body_scale:.2e} L (under {SUBPIXEL_PX} px up to "
+            f"{contract.projected_px:.0f} px across L), normals p99 {contract.normal_deg[1]:.1f}°, "
+            f"colour p99 ΔE {contract.delta_e[1]:.3f}"
+        )
+    else:
+        found = tier_candidates(spec, rig, tier)
+        programs, candidate_note = candidate_index(found, mesh.vertices)
+        region, report, worst_skin, trust = correction_sweep(
+            rig,
+            mesh,
+            ex.normals,
+            (weights.indices, weights.weights),
+            skeleton,
+            choice,
+            programs,
+            envelope.poses,
+        )
+        timings["correction"] = time.perf_counter() - t
+        correction_gates = [
+            _never_worse(report),
+            SurfaceGate(
+                "correctionUncovered",
+                float(np.count_nonzero(region & (programs == NO_PROGRAM))),
+                0.0,
+                "vertices",
+                "max",
+                candidate_note or "region vertices outside every candidate region",
+            ),
+        ]
+        rejected = report.rejected_descent + report.rejected_inversion + report.rejected_gradient
+        progress(
+            f"correction region {int(region.sum()):,} vertices "
+            f"(skin-only seam error {worst_skin / rig.body_scale:.2e} L); "
+            f"corrected residual {report.residual_corrected / rig.body_scale:.2e} L, "
+            f"{report.clamped} clamped, "
+            f"{report.backtracks} backtracks, {rejected} rejected"
+        )
     gates += correction_gates
-    rejected = report.rejected_descent + report.rejected_inversion + report.rejected_gradient
-    progress(
-        f"correction region {int(region.sum()):,} vertices "
-        f"(skin-only seam error {worst_skin / rig.body_scale:.2e} L); "
-        f"corrected residual {report.residual_corrected / rig.body_scale:.2e} L, {report.clamped} clamped, "
-        f"{report.backtracks} backtracks, {rejected} rejected"
-    )
     if strict:
         _fail_on(correction_gates, f"surface {tier} correction")
 
@@ -645,6 +753,8 @@ def _extract_surface(
             0.0,
         ).astype(np.float32),
         extras={"creaturegen": __version__, "tier": tier, **signatures},
+        colour_slots=None if colour is None else colour.slots,
+        colour_weights=None if colour is None else colour.weights,
     )
     sidecar: dict[str, object] = {
         "tier": tier,
@@ -676,6 +786,8 @@ def _extract_surface(
         "gates": [g.as_dict() for g in gates],
         "timings": timings,
     }
+    if contract is not None and colour is not None:
+        sidecar["skinRepresentation"] = contract.describe()
     folder = None
     if cache is not None:
         folder = cache.store(

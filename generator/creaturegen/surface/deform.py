@@ -28,7 +28,7 @@ from __future__ import annotations
 import itertools
 import math
 import time
-from collections.abc import Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 from typing import Final, Literal
 
@@ -120,15 +120,26 @@ class DeformationError(Exception):
     """No skinning method passes a joint's sweep; the message names the joint and the failed gates."""
 
     def __init__(
-        self, joint: str, sweeps: Sequence[MethodSweep], bend_deg: float = 0.0, twist_deg: float = 0.0
+        self,
+        joint: str,
+        sweeps: Sequence[MethodSweep],
+        bend_deg: float = 0.0,
+        twist_deg: float = 0.0,
+        corrected: Sequence[MethodSweep] = (),
     ) -> None:
         self.joint = joint
         self.sweeps = tuple(sweeps)
-        failed = "; ".join(
-            f"{s.method}: "
-            + ", ".join(f"{g.name} {g.value:.4g} vs {g.threshold:.4g} {g.unit}" for g in s.failed)
-            for s in sweeps
-        )
+
+        def listed(group: Sequence[MethodSweep]) -> str:
+            return "; ".join(
+                f"{s.method}: "
+                + ", ".join(f"{g.name} {g.value:.4g} vs {g.threshold:.4g} {g.unit}" for g in s.failed)
+                for s in group
+            )
+
+        failed = listed(sweeps)
+        if corrected:
+            failed += f"; tried with the seam corrected toward the field: {listed(corrected)}"
         reach = (
             f"; the motion turns this joint up to {bend_deg:.0f}° bend and {twist_deg:.0f}° twist (swept "
             "with its margin): a smaller turn (a shorter step or hop, a longer limb) or a thinner limb at "
@@ -690,6 +701,7 @@ class JointChoice:
     sweeps: tuple[MethodSweep, ...]  # every method measured, in preference order
     bend_max_deg: float  # the limits this joint was swept to
     twist_max_deg: float
+    corrected: bool = False  # passed only with its seam corrected (choose_deformation's remedy)
 
     @property
     def gates(self) -> tuple[SurfaceGate, ...]:
@@ -707,6 +719,7 @@ class JointChoice:
             "seam_vertices": self.seam_vertices,
             "bend_max_deg": self.bend_max_deg,
             "twist_max_deg": self.twist_max_deg,
+            "corrected": self.corrected,
             "sweeps": [s.describe() for s in self.sweeps],
         }
 
@@ -865,6 +878,51 @@ def _joint_set(rest: _Rest, indices: I64, weights: F64, skeleton: Skeleton, chil
     )
 
 
+#: Moves one method's seam positions as the shipped body would: (joint child, its vertex sets, the pose,
+#: skinned seam positions (n, 3), each seam vertex's 3×3 normal map (the blended matrix for LBS, whose
+#: normals take its cofactor, else the blended rotation), whether that map is LBS's) → positions.
+_Corrector = Callable[[int, _JointSet, Pose, F64, F64, bool], F64]
+
+
+def seam_corrector(
+    mesh: Mesh,
+    normals: F64,
+    rest_slots: F64,
+    graph: BlendGraph,
+    trust: F64,
+    gate: float,
+    skeleton: Skeleton,
+    indices: I64,
+    weights: F64,
+) -> _Corrector:
+    """The bounded correction of surface/correct.py applied to a joint sweep's seam: every seam vertex the
+    skin leaves farther than ``gate`` from the posed field is corrected within its ``trust`` radius (the
+    runtime corrects the same vertices: a joint chosen this way puts its whole seam in the correction
+    region, surface/build.py), with the full-mesh inversion check over the fans it moves."""
+    from .correct import correct  # correct.py needs nothing of this module; imported where used
+
+    def apply(child: int, js: _JointSet, pose: Pose, seam: F64, maps: F64, is_lbs: bool) -> F64:
+        q, t = pose.rotations[child], pose.translations[child]
+        live = weights > 0
+        rigid = _any_rows(js.moving[indices] & live) & ~_any_rows(~js.moving[indices] & live)
+        full = mesh.vertices.copy()
+        full[rigid] = mesh.vertices[rigid] @ q.T + t
+        full[js.seam] = seam
+        turned = normals.copy()
+        turned[rigid] = normals[rigid] @ q.T
+        rest_n = normals[js.seam]
+        mapped = np.einsum("vij,vj->vi", _cofactor(maps) if is_lbs else maps, rest_n)
+        turned[js.seam] = unit_rows(mapped)
+        field = BodyField(graph, posed_slots(rest_slots, pose))
+        region = np.zeros(mesh.vertex_count, dtype=bool)
+        region[js.seam] = np.abs(field.distance(seam)) > gate
+        out, _ = correct(field, mesh, full, turned, region, trust)
+        result: F64 = out[js.seam]
+        return result
+
+    return apply
+
+
 @dataclass(frozen=True)
 class _SweepResult:
     sweeps: tuple[MethodSweep, ...]
@@ -882,8 +940,13 @@ def _joint_sweep(
     length_scale: float,
     child: int,
     poses: list[tuple[str, Pose]],
+    corrector: _Corrector | None = None,
 ) -> _SweepResult:
     """Every method over one joint's poses, measured on the vertices weighted across the joint.
+
+    With a ``corrector``, every method's seam is first moved as the shipped body moves it: skinned, then
+    corrected toward the posed field (surface/correct.py) where the skin misses it (the remedy of
+    :func:`choose_deformation` for a joint no method carries by skinning alone).
 
     A joint pose moves the subtree by one transform and leaves the rest, so a seam vertex's influences
     reduce exactly to two, "static" (weight 1 − w) and "moving" (w): LBS is linear in the weights and
@@ -944,12 +1007,17 @@ def _joint_sweep(
         # Rigid faces: (Qa + t)·((Qb + t)×(Qc + t)) = a·(b×c) + t·Q((b − a)×(c − a)).
         fixed = float(t @ (q @ js.rigid_area))
         fixed += float((_triple(base[js.mixed_faces]) - js.mixed_triple).sum())
-        lbs, _ = _lbs(seam_v, pair, pair_w, two)
-        dq, _, flips_dq = _dq(seam_v, pair, pair_w, two)
-        cor, _, flips_cor = _cor(seam_v, pair, pair_w, two, rest.centers[js.seam])
+        lbs, lbs_m = _lbs(seam_v, pair, pair_w, two)
+        dq, dq_r, flips_dq = _dq(seam_v, pair, pair_w, two)
+        cor, cor_r, flips_cor = _cor(seam_v, pair, pair_w, two, rest.centers[js.seam])
         flips[1] += flips_dq
         flips[2] += flips_cor
         stacked = np.stack([lbs, dq, cor])  # (3, n, 3)
+        if corrector is not None:
+            rotations = (lbs_m, dq_r, cor_r)
+            stacked = np.stack(
+                [corrector(child, js, pose, stacked[k], rotations[k], k == 0) for k in range(3)]
+            )
         near = stacked[:, joint]
         d = BodyField(graph, posed_slots(rest_slots, pose)).distance(near.reshape(-1, 3)).reshape(3, -1)
         d_joint[p] = d
@@ -1094,6 +1162,7 @@ def choose_deformation(
     centers: F64 | None = None,
     limits: Mapping[int, tuple[float, float]] | None = None,
     limits_from: str = "",
+    corrector: _Corrector | None = None,
 ) -> DeformationChoice:
     """Sweep every joint with every method and keep, per joint, the first method that passes every gate.
 
@@ -1103,6 +1172,12 @@ def choose_deformation(
     (bend, twist) sweep limits in degrees (the measured motion envelope, motion/envelope.py); a joint not
     in it is swept to ``bend_max_deg`` and ``twist_max_deg``. A joint swept to zero never turns: every
     method reproduces it exactly and the cheapest is kept.
+
+    Remedy before refusal: where no method passes by skinning alone and a ``corrector`` is given
+    (:func:`seam_corrector`), the joint is swept again with every method's seam corrected toward the
+    posed field as the shipped body corrects it, and the first method that passes then is kept, marked
+    ``corrected`` (its seam joins the correction region). A thick hip's DQ bulge or CoR collapse that the
+    correction pulls back is not what a user sees.
     """
     start = time.perf_counter()
     idx, w = _as_arrays(indices, weights)
@@ -1131,6 +1206,15 @@ def choose_deformation(
         result = _joint_sweep(rest, idx, w, skeleton, rig_slots, graph, length_scale, child, poses)
         sweeps = result.sweeps
         chosen = next((s.method for s in sweeps if s.passed), None)
+        corrected = False
+        if chosen is None and corrector is not None:
+            retry = _joint_sweep(
+                rest, idx, w, skeleton, rig_slots, graph, length_scale, child, poses, corrector
+            )
+            chosen = next((s.method for s in retry.sweeps if s.passed), None)
+            if chosen is None:
+                raise DeformationError(skeleton.names[child], sweeps, bend, twist, retry.sweeps)
+            result, sweeps, corrected = retry, retry.sweeps, True
         if chosen is None:
             raise DeformationError(skeleton.names[child], sweeps, bend, twist)
         methods[child] = chosen
@@ -1147,6 +1231,7 @@ def choose_deformation(
                 sweeps,
                 bend,
                 twist,
+                corrected,
             )
         )
     where = limits_from or f"every joint {bend_max_deg:g}° bend, {twist_max_deg:g}° twist"

@@ -157,21 +157,29 @@ async function main() {
   // Field queries, outside any frame: the shipped query (one K-instruction tape, distance and analytic
   // gradient together) and the baseline query (every slot's distance, seven times: the value and six
   // central-difference taps), each in its own compute kernel over the rest vertices of body 0 (page 0)
-  // repeated `copies` times, each vertex through its own candidate program. Built on first use.
+  // that query the field, repeated `copies` times, each vertex through its own candidate program (the full
+  // program for noProgram). A skinProgram vertex queries no field in either variant, so it is left out;
+  // when no vertex queries the field (a skin-represented tier) every rest vertex runs the full program, so
+  // the two field paths can still be compared (fieldVertices says which). Built on first use.
   let fieldState = null;
   function fieldKernels(copies) {
     if (fieldState && fieldState.copies === copies) return fieldState;
     const g = pop.geometry.attributes;
-    const nv = g.position.count;
+    const code = (v) => g.cgSkin.array[4 * v + 2];
+    const isSkin = (c) => Math.abs(c - layout.skinProgram) < 0.5;
+    const all = Array.from({ length: g.position.count }, (_, v) => v);
+    const querying = all.filter((v) => !isSkin(code(v)));
+    const rest = querying.length ? querying : all;
+    const nv = rest.length;
     const n = nv * copies;
     const pts = new Float32Array(4 * n);
     for (let i = 0; i < n; i++) {
-      const v = i % nv;
+      const v = rest[i % nv];
       pts[4 * i] = g.position.array[3 * v];
       pts[4 * i + 1] = g.position.array[3 * v + 1];
       pts[4 * i + 2] = g.position.array[3 * v + 2];
-      const c = g.cgSkin.array[4 * v + 2];
-      pts[4 * i + 3] = c > layout.noProgram - 0.5 ? layout.fullProgram : c;
+      const c = code(v);
+      pts[4 * i + 3] = c > layout.skinProgram - 0.5 ? layout.fullProgram : c;
     }
     const points = instancedArray(pts, 'vec4').toReadOnly();
     const fns = baselineFunctions(tsl, layout, pop.pages[0].pose, pop.programs, step);
@@ -186,7 +194,7 @@ async function main() {
       return { node, result };
     };
     fieldState = {
-      copies, n, vertices: nv,
+      copies, n, vertices: nv, fieldVertices: querying.length,
       shipped: kernel(fns.shipped.field.runProgram),
       baseline: kernel(fns.field.runProgram),
     };
@@ -221,7 +229,7 @@ async function main() {
     }
     angles.sort((x, y) => x - y);
     return {
-      points: k.n, gradientsCompared: angles.length, maxAbsDistance: maxAbsD, maxAbsDistanceOverBodyScale: maxAbsD / L,
+      points: k.n, fieldVertices: k.fieldVertices, gradientsCompared: angles.length, maxAbsDistance: maxAbsD, maxAbsDistanceOverBodyScale: maxAbsD / L,
       gradientAngleDeg: angles.length ? { median: sortedQuantile(angles, 0.5), p99: sortedQuantile(angles, 0.99), max: angles.at(-1) } : null,
       maxGradientNormDifference: maxGradNormErr, step,
     };
@@ -237,7 +245,7 @@ async function main() {
     for (let r = 0; r < reps; r++) {
       for (const v of r % 2 ? ['baseline', 'shipped'] : ['shipped', 'baseline']) ms[v].push(await dispatch(k[v]));
     }
-    return { points: k.n, vertices: k.vertices, copies, ms };
+    return { points: k.n, vertices: k.vertices, fieldVertices: k.fieldVertices, copies, ms };
   }
 
   // One frame per animation-frame tick (three advances its node frame once per tick), each timed from

@@ -419,7 +419,8 @@ async function main() {
     async readDeformed(i = 0) {
       const r = await diag.readDeformed(i);
       return { position: toBase64(new Uint8Array(r.position.buffer)), gradient: toBase64(new Uint8Array(r.gradient.buffer)),
-        distance: toBase64(new Uint8Array(r.distance.buffer)), accepted: toBase64(new Uint8Array(r.accepted.buffer)) };
+        distance: toBase64(new Uint8Array(r.distance.buffer)), accepted: toBase64(new Uint8Array(r.accepted.buffer)),
+        colour: toBase64(new Uint8Array(r.colour.buffer)), program: toBase64(new Uint8Array(r.program.buffer)) };
     },
     capturePixels,
     displayPath,

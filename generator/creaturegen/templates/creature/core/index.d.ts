@@ -92,6 +92,9 @@ export interface CreatureData {
   readonly programCount: number;
   readonly fullProgram: number;
   readonly noProgram: number;
+  /** The candidate code of a vertex that evaluates no field (a skin-represented tier): skinned position
+   * and normal, baked colour. */
+  readonly skinProgram: number;
   readonly registers: number;
   readonly candidateNote: string;
   readonly gradientFloor: number;

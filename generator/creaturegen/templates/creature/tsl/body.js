@@ -1,12 +1,14 @@
 // The body path of one vertex, shared by the deform pre-pass (deform.js), the diagnostics kernels and
 // the lab's baseline: skin by the joint's method, correct where the build said so, then one field
-// evaluation at the final position for the normal, the distance and the albedo.
+// evaluation at the final position for the normal, the distance and the albedo; or, for a vertex of a
+// skin-represented tier (program CREATURE.skinProgram), no field at all: skinned position and normal,
+// baked colour.
 //
 // An individual's size s (root row 1 .w, core/genome.js) is a similarity of the certified body: the rest
 // vertex, its centre of rotation and its correction trust radius are scaled by s before skinning, the
 // pose rows already hold the scaled slots (core/pose.js) and the field scales its blend widths (field.js),
 // so the path below is the unit body's times s.
-import { float, int, select } from 'three/tsl';
+import { If, float, int, select, vec3 } from 'three/tsl';
 import { createField } from './field.js';
 import { createSkin } from './skin.js';
 
@@ -19,6 +21,7 @@ export function layoutOf(data) {
     registers: data.registers,
     fullProgram: data.fullProgram,
     noProgram: data.noProgram,
+    skinProgram: data.skinProgram,
     gradientFloor: data.gradientFloor,
     tiny: data.tiny,
     kFloor: data.kFloor,
@@ -41,17 +44,42 @@ export function bodyFunctions(layout, pose, programs) {
 /**
  * One vertex through the whole body path, inline in a Fn: skin, correct (unless skin-only), then one
  * field evaluation at the final position for the normal, the distance and (with `colour`) the albedo.
- * Inputs are nodes so the vertex stage (attributes) and the diagnostics kernels (storage) share it.
+ * A vertex whose program is CREATURE.skinProgram (a skin-represented tier) evaluates no field at all: its
+ * skinned position, its skinned rest normal (in the gradient slot) and, with `colour`, its baked colour;
+ * distance and accepted are 0. Inputs are nodes so the vertex stage (attributes) and the diagnostics
+ * kernels (storage) share it. `program` is the program the field runs (full for noProgram and
+ * skinProgram), `code` the vertex's own candidate code as stored (skinProgram for a skin vertex).
  */
-export function bodyVertex(layout, fns, { rest, slots, weights, skin, cor, base, skinOnly, colour = false }) {
-  const program = select(skin.z.greaterThan(layout.noProgram - 0.5), int(layout.fullProgram), int(skin.z)).toVar();
+export function bodyVertex(layout, fns, {
+  rest, slots, weights, skin, cor, normal, colourSlots, colourWeights, base, skinOnly, colour = false,
+}) {
+  const skinVertexOnly = skin.z.greaterThan(layout.skinProgram - 0.5).and(skin.z.lessThan(layout.skinProgram + 0.5)).toVar();
+  const program = select(skin.z.greaterThan(layout.skinProgram - 0.5), int(layout.fullProgram), int(skin.z)).toVar();
   const s = fns.field.size(base).toVar();
-  const skinned = fns.skin.skinVertex(rest.mul(s), base, slots, weights, skin.x, cor.mul(s)).toVar();
-  const corrected = skinOnly ? { position: skinned, accepted: float(0) } : fns.skin.correctVertex(skinned, base, program, skin.y.mul(s));
-  // One evaluation at the final position: the normal's gradient, the distance and (display) the colour.
-  const final = fns.field.evaluate(corrected.position, base, program, { colour, kFloor: layout.kFloor });
-  return {
-    skinned, position: corrected.position, accepted: corrected.accepted, program,
-    gradient: final.value.yzw, distance: final.value.x, colour: final.colour,
-  };
+  const skinned = vec3(0).toVar();
+  const position = vec3(0).toVar();
+  const accepted = float(0).toVar();
+  const gradient = vec3(0).toVar();
+  const distance = float(0).toVar();
+  const albedo = colour ? vec3(0).toVar() : null;
+  If(skinVertexOnly, () => {
+    // No field: the skinned position and rest normal (no correction: its trust radius is 0), baked colour.
+    const body = fns.skin.skinVertexNormal(rest.mul(s), normal, base, slots, weights, skin.x, cor.mul(s));
+    skinned.assign(body.position);
+    position.assign(body.position);
+    gradient.assign(body.normal);
+    if (colour) albedo.assign(fns.field.bakedColour(base, colourSlots, colourWeights));
+  }).Else(() => {
+    skinned.assign(fns.skin.skinVertex(rest.mul(s), base, slots, weights, skin.x, cor.mul(s)));
+    const corrected = skinOnly ? { position: skinned, accepted: float(0) } : fns.skin.correctVertex(skinned, base, program, skin.y.mul(s));
+    // One evaluation at the final position: the normal's gradient, the distance and (display) the colour.
+    const final = fns.field.evaluate(corrected.position, base, program, { colour, kFloor: layout.kFloor });
+    position.assign(corrected.position);
+    accepted.assign(corrected.accepted);
+    gradient.assign(final.value.yzw);
+    distance.assign(final.value.x);
+    if (colour) albedo.assign(final.colour);
+  });
+  const code = select(skinVertexOnly, float(layout.skinProgram), float(program));
+  return { skinned, position, accepted, program, code, gradient, distance, colour: albedo };
 }

@@ -14,7 +14,7 @@ export { DEBUG_MODES, assertThreeRevision, createCreaturePopulation, createDiagn
 
 /** Layout constants every node graph of this creature shares (layoutOf(CREATURE)). */
 export interface Layout {
-  rows: number; maxParts: number; slotCount: number; registers: number; fullProgram: number; noProgram: number;
+  rows: number; maxParts: number; slotCount: number; registers: number; fullProgram: number; noProgram: number; skinProgram: number;
   gradientFloor: number; tiny: number; kFloor: number; bodyScale: number;
   correction: CreatureData['correction']; vertices: number;
 }
@@ -27,6 +27,8 @@ export interface BodyField {
   evaluate(p: Node, base: Node, program: Node, options?: { colour?: boolean; kFloor?: number }): { value: Node; colour: Node | null };
   runProgram(p: Node, base: Node, program: Node): Node;
   size(base: Node): Node;
+  /** Σ wᵢ·rgb(slotᵢ) / Σ wᵢ over four baked colour slots and weights (vec4 nodes): a skin vertex's albedo. */
+  bakedColour(base: Node, slots: Node, weights: Node): Node;
 }
 export function createField(options: {
   pose: PoseStorage; programs: PoseStorage; rows: number; slotCount: number; registers: number; gradientFloor: number; tiny: number;
@@ -36,6 +38,10 @@ export function rootSize(layout: { slotCount: number; rows: number }, pose: Pose
 export const METHOD: Readonly<{ LBS: 0; DQ: 1; COR: 2 }>;
 export interface BodySkin {
   skinVertex(v: Node, base: Node, slots: Node, weights: Node, method: Node, centre: Node): Node;
+  /** Skinned position and skinned rest normal `n` from one blend (inline in a Fn). */
+  skinVertexNormal(v: Node, n: Node, base: Node, slots: Node, weights: Node, method: Node, centre: Node): { position: Node; normal: Node };
+  /** deform.skin_lbs's normal: cofactor(Σ wᵢRᵢ)·n, normalised. */
+  lbsNormal(n: Node, base: Node, slots: Node, weights: Node): Node;
   correctVertex(p0: Node, base: Node, program: Node, trust: Node): { position: Node; accepted: Node };
   lbs(v: Node, base: Node, slots: Node, weights: Node): Node;
   dq(v: Node, base: Node, slots: Node, weights: Node): Node;
@@ -46,9 +52,11 @@ export function createSkin(options: { pose: PoseStorage; rows: number; field: Bo
 export function rotate(q: Node, v: Node): Node;
 
 export interface BodyFunctions { field: BodyField; skin: BodySkin }
-export interface VertexInputs { rest: Node; slots: Node; weights: Node; cor: Node; skin: Node }
+export interface VertexInputs {
+  rest: Node; slots: Node; weights: Node; cor: Node; skin: Node; normal: Node; colourSlots: Node; colourWeights: Node;
+}
 export interface BodyVertex {
-  skinned: Node; position: Node; accepted: Node; program: Node; gradient: Node; distance: Node; colour: Node | null;
+  skinned: Node; position: Node; accepted: Node; program: Node; code: Node; gradient: Node; distance: Node; colour: Node | null;
 }
 export function layoutOf(data: CreatureData): Layout;
 export function bodyFunctions(layout: Layout, pose: PoseStorage, programs: PoseStorage): BodyFunctions;

@@ -3,7 +3,9 @@
 // root transform (squash, yaw, position), applied once here (a plain Mesh with `count` instances: no
 // instanceMatrix, so nothing is applied twice); the normal takes the transform's inverse transpose and goes
 // to normalLocal, the local-space slot r185 expects. The shadow pass uses this positionNode too (three's
-// default), so it casts the stored surface that is seen.
+// default), so it casts the stored surface that is seen. A vertex of a skin-represented tier (program
+// CREATURE.skinProgram) stores its skinned normal, baked colour and distance 0 there: every view reads it
+// the same way (the 'distance' view shows it on the surface, 'candidates' gives it its own colour).
 import * as THREE from 'three/webgpu';
 import {
   Fn, attribute, clamp, float, fract, instanceIndex, int, mix, normalLocal, normalize, select, sin,

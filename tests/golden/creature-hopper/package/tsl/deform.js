@@ -10,10 +10,13 @@ import { CREATURE } from '../core/data.js';
 import { bodyVertex } from './body.js';
 
 /** vec4 per drawn vertex: (position, distance), (gradient, accepted), (albedo, program); the plan's number,
- * which the build report's deformBytesPerBody also uses. */
+ * which the build report's deformBytesPerBody also uses. A skinProgram vertex stores its skinned normal as
+ * the gradient, distance and accepted 0, and CREATURE.skinProgram as its program. */
 export const DEFORM_STRIDE = CREATURE.deformStride;
-/** vec4 per rest vertex: (rest, 0), slots, weights, (centre of rotation, 0), (method, trust, program, 0). */
-export const RECORD_STRIDE = 5;
+/** vec4 per rest vertex: (rest, 0), slots, weights, (centre of rotation, 0), (method, trust, program, 0),
+ * (rest normal, 0), colour slots, colour weights (the last two zero unless the tier is skin-represented:
+ * they colour the vertices whose program is CREATURE.skinProgram, which evaluate no field). */
+export const RECORD_STRIDE = 8;
 
 /** The rest-vertex records (one read-only storage node shared by every page and kernel). */
 export function vertexRecords(geometry) {
@@ -25,11 +28,14 @@ export function vertexRecords(geometry) {
     for (let c = 0; c < 3; c++) {
       out[o + c] = a.position.array[3 * v + c];
       out[o + 12 + c] = a.cgCor.array[3 * v + c];
+      out[o + 20 + c] = a.normal.array[3 * v + c];
     }
     for (let c = 0; c < 4; c++) {
       out[o + 4 + c] = a.cgSlots.array[4 * v + c];
       out[o + 8 + c] = a.cgWeights.array[4 * v + c];
       out[o + 16 + c] = a.cgSkin.array[4 * v + c];
+      out[o + 24 + c] = a.cgColourSlots.array[4 * v + c];
+      out[o + 28 + c] = a.cgColourWeights.array[4 * v + c];
     }
   }
   return instancedArray(out, 'vec4').toReadOnly();
@@ -40,7 +46,8 @@ export function recordInputs(records, v) {
   const r = v.mul(RECORD_STRIDE);
   return {
     rest: records.element(r).xyz, slots: records.element(r.add(1)), weights: records.element(r.add(2)),
-    cor: records.element(r.add(3)).xyz, skin: records.element(r.add(4)),
+    cor: records.element(r.add(3)).xyz, skin: records.element(r.add(4)), normal: records.element(r.add(5)).xyz,
+    colourSlots: records.element(r.add(6)), colourWeights: records.element(r.add(7)),
   };
 }
 
@@ -73,7 +80,7 @@ export function createDeformKernel(layout, fns, { pose, records, deform, size, v
       const o = idx.mul(DEFORM_STRIDE).toVar();
       deform.element(o).assign(vec4(body.position, body.distance));
       deform.element(o.add(1)).assign(vec4(body.gradient, body.accepted));
-      deform.element(o.add(2)).assign(vec4(body.colour, float(body.program)));
+      deform.element(o.add(2)).assign(vec4(body.colour, body.code));
     });
   })().compute(size * vertices);
   kernel.setName(skinOnly ? 'cgDeformSkinOnly' : 'cgDeform');

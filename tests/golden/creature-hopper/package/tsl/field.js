@@ -97,6 +97,9 @@ export function createField({ pose, programs, rows, slotCount, registers, gradie
     return result;
   };
 
+  // A slot's colour row: (k, rgb), rgb the individual's linear slot colour (core/pose.js).
+  const colourRow = (base, slot) => pose.element(base.add(slot.mul(rows)).add(2));
+
   // blend.poly_smin: h from the distances, gradient mixed with the same h (exact).
   const poly = (l, r, k) => {
     const h = clamp(float(0.5).add(float(0.5).mul(l.x.sub(r.x)).div(k)), 0, 1).toVar();
@@ -156,7 +159,7 @@ export function createField({ pose, programs, rows, slotCount, registers, gradie
     Loop(count, ({ i }) => {
       const ins = programs.element(offset.add(i));
       If(int(ins.x).equal(OP.LEAF), () => {
-        const row = pose.element(base.add(int(ins.y).mul(rows)).add(2));
+        const row = colourRow(base, int(ins.y));
         const w = exp(max(regs.element(i).x.sub(dMin), 0).negate().div(max(row.x, size.mul(kFloor))));
         sum.addAssign(w);
         rgb.addAssign(row.yzw.mul(w));
@@ -165,13 +168,29 @@ export function createField({ pose, programs, rows, slotCount, registers, gradie
     return { value, colour: rgb.div(sum) };
   };
 
+  /**
+   * The baked colour of a vertex that evaluates no field: Σ wᵢ·rgb(slotᵢ) / Σ wᵢ over its four baked
+   * colour slots and weights (vec4 each), rgb the individual's slot colour, the row the colour kernel
+   * above reads (linear RGB).
+   */
+  const bakedColour = (base, slots, weights) => {
+    const rgb = vec3(0).toVar();
+    const sum = float(0).toVar();
+    for (let c = 0; c < 4; c++) {
+      const w = weights.element(c);
+      rgb.addAssign(colourRow(base, int(slots.element(c))).yzw.mul(w));
+      sum.addAssign(w);
+    }
+    return rgb.div(sum);
+  };
+
   /** vec4(d, ∇d) of program `program` at `p` (evaluate without the colour). */
   const runProgram = Fn(([p, base, program]) => evaluate(p, base, program).value);
 
   /** The instance's size (the body path scales its rest vertex, centre of rotation and trust radius). */
   const size = (base) => rootSize({ slotCount, rows }, pose, base);
 
-  return { slotField, evaluate, runProgram, size };
+  return { slotField, evaluate, runProgram, size, bakedColour };
 }
 
 

@@ -50,6 +50,10 @@ export function surfaceGeometry(surface) {
     skin[4 * i + 2] = a._CANDIDATE.array[i];
   }
   geometry.setAttribute('cgSkin', new THREE.BufferAttribute(skin, 4));
+  // The baked colours of the vertices that evaluate no field (a skin-represented tier); zeros elsewhere,
+  // where no vertex has CREATURE.skinProgram.
+  geometry.setAttribute('cgColourSlots', new THREE.BufferAttribute(a._COLOUR_SLOTS?.array ?? new Float32Array(4 * n), 4));
+  geometry.setAttribute('cgColourWeights', new THREE.BufferAttribute(a._COLOUR_WEIGHTS?.array ?? new Float32Array(4 * n), 4));
   geometry.setIndex(new THREE.BufferAttribute(surface.index.array, 1));
   return geometry;
 }

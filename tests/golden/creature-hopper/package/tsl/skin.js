@@ -2,7 +2,7 @@
 // Skinning the reference mesh from the pose page, and the bounded local correction: the formulas of
 // creaturegen's surface/deform.py (LBS, dual quaternion, centre of rotation; the method per vertex is
 // its joint's choice, baked into the asset) and of creature/reference.py (the per-vertex correction).
-import { Fn, If, Loop, Break, abs, float, int, select, sqrt, vec3, vec4 } from 'three/tsl';
+import { Fn, If, Loop, Break, abs, float, int, normalize, select, sqrt, vec3, vec4 } from 'three/tsl';
 
 const dot3 = (u, v) => u.x.mul(v.x).add(u.y.mul(v.y)).add(u.z.mul(v.z));
 const dot4 = (u, v) => u.x.mul(v.x).add(u.y.mul(v.y)).add(u.z.mul(v.z)).add(u.w.mul(v.w));
@@ -64,23 +64,42 @@ export function createSkin({ pose, rows, field, correction }) {
     return { real, dual };
   };
 
-  // deform._dq: normalised blended dual quaternion.
-  const dq = (v, base, slots, weights) => {
+  // deform._dq: normalised blended dual quaternion (real part br, dual part bd).
+  const dqBlend = (base, slots, weights) => {
     const { real, dual } = blendQuats(base, slots, weights, true);
     const norm = sqrt(dot4(real, real));
-    const br = real.div(norm).toVar();
-    const bd = dual.div(norm);
+    return { br: real.div(norm).toVar(), bd: dual.div(norm) };
+  };
+  const dqApply = ({ br, bd }, v) => {
     const conj = vec4(br.xyz.negate(), br.w);
     const translation = qmul(bd, conj).xyz.mul(2);
     return rotate(br, v).add(translation);
   };
+  const dq = (v, base, slots, weights) => dqApply(dqBlend(base, slots, weights), v);
 
   // deform._cor: v' = R(v − p*) + LBS(p*), R the normalised blend of the hemisphere-aligned rotations.
-  const cor = (v, base, slots, weights, centre) => {
+  const corRotation = (base, slots, weights) => {
     const { real } = blendQuats(base, slots, weights, false);
-    const br = real.div(sqrt(dot4(real, real)));
-    return rotate(br, v.sub(centre)).add(lbs(centre, base, slots, weights));
+    return real.div(sqrt(dot4(real, real))).toVar();
   };
+  const corApply = (br, v, base, slots, weights, centre) => rotate(br, v.sub(centre)).add(lbs(centre, base, slots, weights));
+  const cor = (v, base, slots, weights, centre) => corApply(corRotation(base, slots, weights), v, base, slots, weights, centre);
+
+  // deform.skin_lbs's normal: cofactor(M)·n = det(M)·M⁻ᵀn, M = Σ wᵢRᵢ by its columns cₖ = Σ wᵢRᵢeₖ, so
+  // n₀(c₁×c₂) + n₁(c₂×c₀) + n₂(c₀×c₁), normalised.
+  const lbsNormal = (n, base, slots, weights) => {
+    const c0 = vec3(0).toVar(), c1 = vec3(0).toVar(), c2 = vec3(0).toVar();
+    for (let c = 0; c < 4; c++) {
+      const q = quat(base, int(slots.element(c))).toVar();
+      const w = weights.element(c);
+      c0.addAssign(rotate(q, vec3(1, 0, 0)).mul(w));
+      c1.addAssign(rotate(q, vec3(0, 1, 0)).mul(w));
+      c2.addAssign(rotate(q, vec3(0, 0, 1)).mul(w));
+    }
+    return normalize(c1.cross(c2).mul(n.x).add(c2.cross(c0).mul(n.y)).add(c0.cross(c1).mul(n.z)));
+  };
+  // deform.skin_dq / skin_cor's normal: the blended (normalised) rotation of the position's own blend.
+  const rotatedNormal = (br, n) => normalize(rotate(br, n));
 
   /** The skinned (uncorrected) position of one vertex; `method` is its joint's choice (0, 1, 2). */
   const skinVertex = Fn(([v, base, slots, weights, method, centre]) => {
@@ -90,6 +109,29 @@ export function createSkin({ pose, rows, field, correction }) {
       .Else(() => { out.assign(cor(v, base, slots, weights, centre)); });
     return out;
   });
+
+  /**
+   * The skinned position and the skinned rest normal `n` of one vertex (a vertex that evaluates no field),
+   * each method's normal from the same blend its position uses (deform.py skin_lbs, skin_dq, skin_cor).
+   * Inline (call it inside a Fn): returns { position, normal } nodes.
+   */
+  const skinVertexNormal = (v, n, base, slots, weights, method, centre) => {
+    const position = vec3(0).toVar();
+    const normal = vec3(0).toVar();
+    If(method.lessThan(0.5), () => {
+      position.assign(lbs(v, base, slots, weights));
+      normal.assign(lbsNormal(n, base, slots, weights));
+    }).ElseIf(method.lessThan(1.5), () => {
+      const blend = dqBlend(base, slots, weights);
+      position.assign(dqApply(blend, v));
+      normal.assign(rotatedNormal(blend.br, n));
+    }).Else(() => {
+      const br = corRotation(base, slots, weights);
+      position.assign(corApply(br, v, base, slots, weights, centre));
+      normal.assign(rotatedNormal(br, n));
+    });
+    return { position, normal };
+  };
 
   /**
    * Bounded Newton correction toward the zero set: Δp = −(d/|∇d|²)∇d clamped to the vertex's trust
@@ -134,6 +176,6 @@ export function createSkin({ pose, rows, field, correction }) {
     return { position: out, accepted };
   };
 
-  return { skinVertex, correctVertex, lbs, dq, cor };
+  return { skinVertex, skinVertexNormal, correctVertex, lbs, dq, cor, lbsNormal };
 }
 
