@@ -653,27 +653,31 @@ def _extract_surface(
     colour: BakedColour | None = None
     contract: SkinContract | None = None
     skin_tol = TIERS[tier].skin
+    if skin_tol is None:
+        found = tier_candidates(spec, rig, tier)
+        programs, candidate_note = candidate_index(found, mesh.vertices)
+    else:
+        found = candidate_note = skin_note(tier)
+        # Every vertex may be corrected through the tier's one program (the full graph, index 0) ...
+        programs = np.zeros(mesh.vertex_count, dtype=np.int64)
+    region, report, worst_skin, trust = correction_sweep(
+        rig,
+        mesh,
+        ex.normals,
+        (weights.indices, weights.weights),
+        skeleton,
+        choice,
+        programs,
+        envelope.poses,
+    )
     if skin_tol is not None:
         colour, departures = _skin_departures(
             rig, mesh, ex.normals, weights, skeleton, choice, envelope.poses
-        )
-        found = candidate_note = skin_note(tier)
-        # Every vertex may be corrected through the tier's one program (the full graph, index 0) ...
-        region, report, worst_skin, trust = correction_sweep(
-            rig,
-            mesh,
-            ex.normals,
-            (weights.indices, weights.weights),
-            skeleton,
-            choice,
-            np.zeros(mesh.vertex_count, dtype=np.int64),
-            envelope.poses,
         )
         # ... and those the skin carries within the tier's tolerances evaluate nothing at all.
         in_field = region | field_vertices(departures, SKIN_ERROR_FACTOR * rig.body_scale, skin_tol)
         programs = np.where(in_field, 0, SKIN_PROGRAM).astype(np.int64)
         contract = skin_contract(departures, in_field, weights.indices[:, 0], rig, colour)
-        timings["correction"] = time.perf_counter() - t
         correction_gates = [_never_worse(report)]
         progress(
             f"skin representation: {contract.field_vertices:,} of {contract.vertices:,} vertices evaluate "
@@ -683,19 +687,6 @@ def _extract_surface(
             f"colour p99 ΔE {contract.delta_e[1]:.3f}"
         )
     else:
-        found = tier_candidates(spec, rig, tier)
-        programs, candidate_note = candidate_index(found, mesh.vertices)
-        region, report, worst_skin, trust = correction_sweep(
-            rig,
-            mesh,
-            ex.normals,
-            (weights.indices, weights.weights),
-            skeleton,
-            choice,
-            programs,
-            envelope.poses,
-        )
-        timings["correction"] = time.perf_counter() - t
         correction_gates = [
             _never_worse(report),
             SurfaceGate(
@@ -715,6 +706,7 @@ def _extract_surface(
             f"{report.clamped} clamped, "
             f"{report.backtracks} backtracks, {rejected} rejected"
         )
+    timings["correction"] = time.perf_counter() - t
     gates += correction_gates
     if strict:
         _fail_on(correction_gates, f"surface {tier} correction")
