@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import numpy as np
+
 from creaturegen.surface.build import EXTRA_REFINEMENTS, MAX_REFINEMENTS, SMALL_LATTICE_NODES, _may_refine
 from creaturegen.surface.grid import Grid
 
@@ -21,6 +23,35 @@ def test_extra_refinements_only_while_the_lattice_is_small() -> None:
     big = _grid(121)  # 1.77 M nodes, 5.0 M after a √2 refinement
     assert SMALL_LATTICE_NODES < 2.0**1.5 * 121**3
     assert not _may_refine(MAX_REFINEMENTS, big)
+
+
+def test_a_lower_tier_may_refine_as_far_as_the_hero_would() -> None:
+    """The distant lattice starts two √2 refinements coarser than the hero's (sagitta target 0.25 vs 0.06),
+    the repeated one one: their budgets count from the hero's first lattice."""
+    from conftest import EXAMPLES
+    from creaturegen.rig import compile_rig
+    from creaturegen.spec import CharacterSpec, load_spec
+    from creaturegen.surface.build import tier_offset
+    from creaturegen.surface.grid import ERROR_TARGET, spacing_for
+
+    spec = load_spec(EXAMPLES / "reference" / "hopper.json")
+    assert isinstance(spec, CharacterSpec)
+    slots = compile_rig(spec).slots
+
+    big = _grid(121)
+    assert [tier_offset(t) for t in ("hero", "repeated", "distant")] == [0, 1, 2]
+    assert not _may_refine(MAX_REFINEMENTS, big, "hero")
+    assert _may_refine(MAX_REFINEMENTS, big, "repeated")
+    assert not _may_refine(MAX_REFINEMENTS + 1, big, "repeated")
+    assert _may_refine(MAX_REFINEMENTS + 1, big, "distant")
+    assert not _may_refine(MAX_REFINEMENTS + 2, big, "distant")
+    small = _grid(49)
+    assert _may_refine(MAX_REFINEMENTS + 2 + EXTRA_REFINEMENTS - 1, small, "distant")
+    # The offset is the spacing ratio in √2 steps, to the nearest step.
+    for tier in ("repeated", "distant"):
+        steps = 2.0 * np.log2(spacing_for(slots, tier) / spacing_for(slots, "hero"))
+        assert abs(steps - tier_offset(tier)) < 0.1
+        assert ERROR_TARGET[tier] > ERROR_TARGET["hero"]
 
 
 def test_a_pointed_tip_starts_at_the_first_lattice_cap_and_refines_up_to_the_limit() -> None:

@@ -8,6 +8,7 @@ three signatures (surface/asset.py); a hit skips everything but reading the file
 
 from __future__ import annotations
 
+import math
 import sys
 import time
 from collections.abc import Callable
@@ -41,7 +42,7 @@ from .correct import CorrectionReport, correct, trust_radius
 from .extract import Extraction, extract
 from .field64 import BodyField
 from .gates import DISTANCE_TOL, Direction, SurfaceGate, mesh_gates
-from .grid import FIRST_CELLS_LIMIT, Grid, GridTooFineError, make_grid
+from .grid import ERROR_TARGET, FIRST_CELLS_LIMIT, Grid, GridTooFineError, make_grid
 from .handles import handle_contacts
 from .mesh import Mesh
 from .sampling import sample_band
@@ -328,9 +329,9 @@ def _fail_on(gates: list[SurfaceGate], where: str, remedy: str = "") -> None:
 def _mesh_remedy(refinement: int, spacing: float) -> str:
     """What the build tried for a mesh gate, and what the user can change (the gate names the place)."""
     return (
-        f"; tried {refinement + 1} lattices, the finest at h = {spacing:.3g} m: a feature there is thinner "
-        "or tighter than the lattice resolves; thicken the part named, or widen the blend k (or the gap) "
-        "where it meets its neighbour"
+        f"; refining the lattice did not help (the best lattice tried, refinement {refinement} at "
+        f"h = {spacing:.3g} m, is reported): a feature there is thinner or tighter than the lattice "
+        "resolves; thicken the part named, or widen the blend k (or the gap) where it meets its neighbour"
     )
 
 
@@ -420,12 +421,21 @@ class ValidatedMesh:
     timings: dict[str, float]
 
 
-def _may_refine(refinement: int, grid: Grid) -> bool:
-    """Whether the lattice after ``grid`` (refinement + 1) is within the refinement budget."""
-    if refinement < MAX_REFINEMENTS:
+def tier_offset(tier: str) -> int:
+    """√2 refinements from the tier's first lattice to the hero tier's: h grows with √ε (surface/grid.py),
+    so a tier whose sagitta target is 2ⁿ times the hero's starts n refinements coarser."""
+    return max(round(math.log2(ERROR_TARGET[tier] / ERROR_TARGET[DEFAULT_TIER])), 0)
+
+
+def _may_refine(refinement: int, grid: Grid, tier: str = DEFAULT_TIER) -> bool:
+    """Whether the lattice after ``grid`` (refinement + 1) is within the refinement budget. A lower tier's
+    budget counts from the hero's first lattice: it may refine as far as the hero would, so a mesh gate
+    the hero's lattices pass never refuses a lower tier for starting coarser."""
+    base = MAX_REFINEMENTS + tier_offset(tier)
+    if refinement < base:
         return True
     nodes = 2.0**1.5 * float(np.prod(grid.shape))  # √2 finer along each axis
-    return refinement < MAX_REFINEMENTS + EXTRA_REFINEMENTS and nodes <= SMALL_LATTICE_NODES
+    return refinement < base + EXTRA_REFINEMENTS and nodes <= SMALL_LATTICE_NODES
 
 
 def _failed_count(attempt: ValidatedMesh) -> int:
@@ -459,7 +469,7 @@ def validated_mesh(
         if failed == ["euler"] and attempt.policy.handles_certain:
             progress("the field itself closes these handles: a finer lattice cannot open them")
             break
-        if not _may_refine(refinement, attempt.grid):
+        if not _may_refine(refinement, attempt.grid, tier):
             break
         progress("refining the lattice by √2 and extracting again")
         refinement += 1
