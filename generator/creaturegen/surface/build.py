@@ -41,6 +41,7 @@ from .components import ComponentPolicy, component_policy
 from .correct import CorrectionReport, correct, trust_radius
 from .extract import Extraction, extract
 from .field64 import BodyField
+from .flips import flip_to_field
 from .gates import DISTANCE_TOL, Direction, SurfaceGate, mesh_gates
 from .grid import ERROR_TARGET, FIRST_CELLS_LIMIT, Grid, GridTooFineError, make_grid
 from .handles import handle_contacts
@@ -79,6 +80,10 @@ FACE_NORMAL_MAX_DEG = 60.0
 #: Vertices within this many lattice cells of a hard-min crease between two blend roots are left out of
 #: the normal gates: the analytic normal itself jumps there, so no mesh normal can agree with it.
 CREASE_BAND_CELLS = 2.0
+#: The mesh gates an edge flip can mend (surface/flips.py), tried before a finer lattice.
+NORMAL_GATES = frozenset(
+    {"vertexNormalAngleMax", "vertexNormalAngleP99", "faceNormalAngleMax", "faceNormalAngleP99", "inverted"}
+)
 #: Finer lattices tried (each √2 finer) when a mesh gate fails before the build gives up ...
 MAX_REFINEMENTS = 2
 #: ... and further ones, up to EXTRA_REFINEMENTS more, while the lattice stays under SMALL_LATTICE_NODES
@@ -525,6 +530,23 @@ def _one_lattice(
         f"mesh gates: {len(gates) - len(failed)}/{len(gates)} passed"
         + (f"; failed {failed}" if failed else "")
     )
+    if any(name in NORMAL_GATES for name in failed):
+        # Remedy before refining: triangles that span a bend along the wrong diagonal (surface/flips.py).
+        t = time.perf_counter()
+        flipped_mesh, flips = flip_to_field(mesh, rest_field.gradient)
+        if flips:
+            flipped_ex = replace(ex, mesh=flipped_mesh)
+            again, again_policy = surface_mesh_gates(rig, flipped_ex, rest_field, skeleton, grid.spacing)
+            still = [g.name for g in again if not g.passed]
+            if len(still) < len(failed) or (len(still) == len(failed) and set(still) <= set(failed)):
+                ex, mesh, gates, policy, failed = flipped_ex, flipped_mesh, again, again_policy, still
+            progress(
+                f"{flips} edges flipped toward the field: mesh gates {len(again) - len(still)}/{len(again)} "
+                f"passed"
+                + (f"; failed {still}" if still else "")
+                + ("" if ex is flipped_ex else " (not kept)")
+            )
+        timings["validation"] += time.perf_counter() - t
     sampling = SamplingReport(
         chosen.name,
         why,

@@ -2844,7 +2844,7 @@ export const CREATURE = Object.freeze({
     0
   ],
   "signatures": {
-    "compilerSignature": "f67d782157b418239b2e30c2d5b96809f347a06f47c4e8681c82ad58f54993e2",
+    "compilerSignature": "205c669094abb32c01178beb0613f60fa76ad592f7da319f9c76e40365887f32",
     "geometryDigest": "400b0d18a2a9f6bbbfe5b441f89767f552a4f3b4c45a368d1129d632e1d2f4f1",
     "topologySignature": "330d551e8c006f84b01459c84db69ca8c43aec5bc9d9083d3e85c291be5a68bf"
   },
