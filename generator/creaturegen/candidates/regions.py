@@ -53,7 +53,9 @@ class Tier:
         return slot_count if self.k_cap is None else min(self.k_cap, slot_count)
 
 
-#: The hero tier may keep every leaf (the full graph is always exact); the others have hard caps.
+#: The hero tier may keep every leaf (the full graph is always exact). The lower tiers keep the seed's
+#: authored K and caps for the record, but use the skin representation and so no candidate programs:
+#: their field vertices run the full graph (surface/skin_tier.py).
 TIERS = {
     "hero": Tier("hero", 8, None),
     "repeated": Tier("repeated", 6, 8, SkinTolerance(10.0, 0.02)),

@@ -38,6 +38,7 @@ import numpy.typing as npt
 from ..field import layout as col
 from ..rig.graph import BlendGraph
 from . import topology
+from .correct import correct
 from .field64 import BodyField
 from .gates import SurfaceGate
 from .mesh import Mesh, angles_deg, unit_rows
@@ -899,7 +900,6 @@ def seam_corrector(
     skin leaves farther than ``gate`` from the posed field is corrected within its ``trust`` radius (the
     runtime corrects the same vertices: a joint chosen this way puts its whole seam in the correction
     region, surface/build.py), with the full-mesh inversion check over the fans it moves."""
-    from .correct import correct  # correct.py needs nothing of this module; imported where used
 
     def apply(child: int, js: _JointSet, pose: Pose, seam: F64, maps: F64, is_lbs: bool) -> F64:
         q, t = pose.rotations[child], pose.translations[child]

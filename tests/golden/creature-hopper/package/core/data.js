@@ -2844,7 +2844,7 @@ export const CREATURE = Object.freeze({
     0
   ],
   "signatures": {
-    "compilerSignature": "205c669094abb32c01178beb0613f60fa76ad592f7da319f9c76e40365887f32",
+    "compilerSignature": "563e91739825edfa0be6307fe3440466cd82ac36b1ce0cb47aa01e240343f6f4",
     "geometryDigest": "400b0d18a2a9f6bbbfe5b441f89767f552a4f3b4c45a368d1129d632e1d2f4f1",
     "topologySignature": "330d551e8c006f84b01459c84db69ca8c43aec5bc9d9083d3e85c291be5a68bf"
   },
