@@ -1,11 +1,13 @@
 """The consumer job: creaturegen as a user meets it, outside this repository.
 
 A wheel of the tool is installed into a fresh venv (a normal install, not editable, without the lab
-extra); that install builds two creature packages and a frost package; each is ``npm pack``-ed and the
-tarballs are installed beside three@0.185.1 into a fresh project in a temporary folder. The project then
-type-checks the packages' README snippets and a typed use of every export with ``tsc --strict``, bundles
-one page with esbuild and with Vite, and runs the page three ways in Chromium (WebGPU on SwiftShader):
-unbundled through an import map into node_modules (the reference), the esbuild bundle and the Vite build.
+extra); that install builds two creature packages (one at the hero tier, one at the distant tier, whose
+skin representation evaluates the field only on its field vertices) and a frost package; each is
+``npm pack``-ed and the tarballs are installed beside three@0.185.1 into a fresh project in a temporary
+folder. The project then type-checks the packages' README snippets and a typed use of every export with
+``tsc --strict``, bundles one page with esbuild and with Vite, and runs the page three ways in Chromium
+(WebGPU on SwiftShader): unbundled through an import map into node_modules (the reference), the esbuild
+bundle and the Vite build.
 
 What must hold: each creature renders its own body (its silhouette matches the same package's unbundled
 render and not the other package's), bodies move between ticks, frost renders, no error anywhere. The
@@ -39,9 +41,11 @@ from creaturegen.lab.server import serve
 
 REPO = Path(__file__).resolve().parent.parent
 CONSUMER = REPO / "tests" / "consumer"
+#: slug → (spec, tier): one hero package, one in the lower tiers' skin representation (surface/skin_tier.py),
+#: so both representations meet the wheel, the tarball, tsc and the bundlers.
 CREATURES = {
-    "hopper-squash-core": "examples/reference/hopper.json",
-    "quadruped-rope-tail": "examples/reference/quadruped.json",
+    "hopper-squash-core": ("examples/reference/hopper.json", "hero"),
+    "quadruped-rope-tail": ("examples/reference/quadruped.json", "distant"),
 }
 FROST = ("frost-pane-balanced", "examples/frost/frost-balanced.json")
 #: What the runtime fetches (the creature's surface, frost's structure); spec.json and preview.png are not.
@@ -100,8 +104,10 @@ def consumer(tmp_path_factory: pytest.TempPathFactory) -> Consumer:
     _run([str(pip), "install", "--quiet", "--disable-pip-version-check", str(wheel)], work, env)
     tool = work / "venv" / "bin" / "creaturegen"
     logs = {}
-    for slug, spec in [*CREATURES.items(), FROST]:
-        logs[slug] = _run([str(tool), "build", str(REPO / spec), "-o", str(work / "out")], work, env)
+    for slug, (spec, tier) in CREATURES.items():
+        command = [str(tool), "build", str(REPO / spec), "--tier", tier, "-o", str(work / "out")]
+        logs[slug] = _run(command, work, env)
+    logs[FROST[0]] = _run([str(tool), "build", str(REPO / FROST[1]), "-o", str(work / "out")], work, env)
     tarballs = {}
     npm = _npm()
     for slug in [*CREATURES, FROST[0]]:

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import itertools
 import math
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -130,3 +131,30 @@ def test_worker_processes_do_not_change_the_envelope(monkeypatch: pytest.MonkeyP
         measured.append(envelope._to_json(envelope.measure_envelope(data, rig.slots, skeleton)))
     assert envelope.envelope_workers(2) == 2  # at most one process per run
     assert measured[0] == measured[1]
+
+
+def test_a_started_envelope_is_the_measured_one_and_stops_when_left(
+    monkeypatch: pytest.MonkeyPatch, tmp_path: Path
+) -> None:
+    """The surface stage starts the envelope's workers before it extracts the mesh and waits afterwards:
+    the result is the envelope measured in one go, and a build that leaves early (a mesh gate refused)
+    leaves no worker running."""
+    monkeypatch.setenv("CREATUREGEN_CACHE", str(tmp_path))
+    monkeypatch.setenv(envelope.WORKERS_ENV, "2")
+    monkeypatch.setattr(envelope, "_MEMORY", {})
+    spec, rig, data, skeleton = _load("reference/flyer.json")
+    with envelope.start_pose_envelope(spec, rig) as pending:
+        pool = pending._pool
+        assert pool is not None, "two workers were asked for: the runs step in forked processes"
+        workers = list(pool._pool)
+        started = envelope._to_json(pending.result())
+    assert started == envelope._to_json(envelope.measure_envelope(data, rig.slots, skeleton))
+    assert not any(w.is_alive() for w in workers)
+
+    monkeypatch.setattr(envelope, "_MEMORY", {})
+    monkeypatch.setenv("CREATUREGEN_CACHE", str(tmp_path / "other"))
+    with envelope.start_pose_envelope(spec, rig) as pending:
+        workers = list(pending._pool._pool)
+    assert not any(w.is_alive() for w in workers), (
+        "workers outlived a build that never asked for the envelope"
+    )

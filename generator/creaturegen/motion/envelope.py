@@ -68,9 +68,11 @@ F64 = npt.NDArray[np.float64]
 #: initial plant, and both are poses a spawned instance shows.
 CYCLES: Final = 2
 MIN_SECONDS: Final = 4.0
-#: The longest cycle the envelope steps (CYCLES of it per run): a slower creature is refused by name
-#: instead of stepping for minutes (a hopper at scale 1000 hops for half a minute).
-MAX_CYCLE_S: Final = 20.0
+#: The most ticks the envelope steps over all its runs: a creature whose slow cycle would need more is
+#: refused by name instead of stepping for many minutes (a hopper at scale 1000 hops for half a minute).
+#: It is the budget a cap of 20 s per cycle gave a walker's 117 runs (117 × CYCLES × 20 s × 60 Hz), so a
+#: swimmer or a flyer, with 9 or 17 runs, may have a slower cycle than a walker (a 32 s undulation).
+MAX_ENVELOPE_TICKS: Final = 280_800
 #: Poses of the envelope handed to the whole-body sweeps (candidate programs, skin correction), chosen
 #: by farthest-point selection over all sampled ticks, starting from the pose that moves slots most.
 SWEEP_POSES: Final = 8
@@ -173,18 +175,19 @@ def _period(data: dict[str, Any]) -> int:
     return 0
 
 
-def run_ticks(data: dict[str, Any]) -> int:
+def run_ticks(data: dict[str, Any], runs: int = 1) -> int:
     """Ticks per run: CYCLES of the slowest corner individual's period (gait and size genes stretch it),
-    and at least MIN_SECONDS."""
+    and at least MIN_SECONDS; refused when ``runs`` such runs exceed MAX_ENVELOPE_TICKS."""
     period = max(_period(express(data, genome)) for _, genome in corner_genomes(data))
     hz = int(data["hz"])
-    if period > MAX_CYCLE_S * hz:
+    ticks = max(CYCLES * period, math.ceil(MIN_SECONDS * hz))
+    if runs * ticks > MAX_ENVELOPE_TICKS:
         raise MotionRangeError(
-            f"locomotion: one {data['type']} cycle lasts {period / hz:.1f} s (at the slowest gene corner), "
-            f"longer than the {MAX_CYCLE_S:g} s the motion envelope measures: lower the locomotion lengths "
-            "and heights (or the scale), or raise locomotion.speed"
+            f"locomotion: one {data['type']} cycle lasts {period / hz:.1f} s (at the slowest gene corner): "
+            f"{runs} runs of {ticks:,} ticks, over the {MAX_ENVELOPE_TICKS:,} the motion envelope steps; "
+            "lower the locomotion lengths and heights (or the scale), or raise locomotion.speed"
         )
-    return max(CYCLES * period, math.ceil(MIN_SECONDS * hz))
+    return ticks
 
 
 def corner_genomes(data: dict[str, Any]) -> list[tuple[str, Genome]]:
@@ -311,9 +314,15 @@ def _record(
 ) -> tuple[list[str], int, F64, F64, list[str]]:
     """(run labels, ticks per run, quaternions (N, S, 4) wxyz, translations (N, S, 3) of the unit body,
     sample labels)."""
-    ticks = run_ticks(data)
+    ticks = run_ticks(data, len(runs))
+    return _recorded(runs, ticks, _step_runs([motion for _, motion in runs], ticks, workers))
+
+
+def _recorded(
+    runs: list[tuple[str, Motion]], ticks: int, stepped: list[tuple[F64, F64]]
+) -> tuple[list[str], int, F64, F64, list[str]]:
+    """``_record``'s result from the stepped runs."""
     labels = [label for label, _ in runs]
-    stepped = _step_runs([motion for _, motion in runs], ticks, workers)
     sample_labels = [f"{label} tick {tick}" for label in labels for tick in range(ticks + 1)]
     quats = np.concatenate([q for q, _ in stepped]) if stepped else np.zeros((0, 0, 4))
     trans = np.concatenate([t for _, t in stepped]) if stepped else np.zeros((0, 0, 3))
@@ -373,7 +382,20 @@ def measure_envelope(
         workers = envelope_workers(len(runs))
     else:
         workers = 1
-    labels, ticks, quats, trans, sample_labels = _record(data, runs, workers)
+    return _summarise(data, rest, skeleton, *_record(data, runs, workers))
+
+
+def _summarise(
+    data: dict[str, Any],
+    rest: F64,
+    skeleton: Skeleton,
+    labels: list[str],
+    ticks: int,
+    quats: F64,
+    trans: F64,
+    sample_labels: list[str],
+) -> PoseEnvelope:
+    """The envelope of the recorded runs: every joint and slot measured, the sweep poses picked."""
     root = int(data["roots"][0])
     q, t = _root_frame(quats, trans, root)
     joints = tuple(_joint(skeleton, rest, q, t, p, c) for p, c in skeleton.joints)
@@ -434,21 +456,85 @@ def pose_envelope(spec: CharacterSpec, rig: CompiledRig) -> PoseEnvelope:
     """The envelope of ``spec``'s motion. Stepping every run takes seconds and the candidate stage, the
     surface stage and the plan all ask, so it is kept in memory and on disk beside the surface cache,
     keyed by the motion data, the rest slots and the generator's sources (floats round-trip exactly)."""
+    with start_pose_envelope(spec, rig) as pending:
+        return pending.result()
+
+
+class PendingEnvelope:
+    """An envelope being measured by forked workers while the caller does other work (the surface stage
+    samples and extracts the mesh meanwhile: on two cores its single-threaded numpy leaves one idle).
+    ``result()`` waits for it; leaving the ``with`` block without asking stops the workers."""
+
+    def __init__(
+        self,
+        key: str,
+        ready: PoseEnvelope | None,
+        measure: tuple[dict[str, Any], F64, Skeleton] | None = None,
+    ) -> None:
+        self._key, self._ready, self._measure = key, ready, measure
+        self._pool: Any = None
+        self._stepping: Any = None
+        self._runs: list[tuple[str, Motion]] = []
+        self._ticks = 0
+        if ready is None and measure is not None:
+            data = measure[0]
+            runs = envelope_runs(data)
+            workers = envelope_workers(len(runs))
+            self._ticks = run_ticks(data, len(runs))
+            self._runs = runs
+            if workers > 1 and "fork" in multiprocessing.get_all_start_methods():
+                motions = [motion for _, motion in runs]
+                context = multiprocessing.get_context("fork")
+                self._pool = context.Pool(workers, initializer=_adopt, initargs=(motions, self._ticks))
+                self._stepping = self._pool.map_async(_step_forked, range(len(runs)), chunksize=1)
+                self._pool.close()
+
+    def __enter__(self) -> PendingEnvelope:
+        return self
+
+    def __exit__(self, *_: object) -> None:
+        if self._pool is not None:
+            self._pool.terminate()
+            self._pool.join()
+            self._pool = None
+
+    def result(self) -> PoseEnvelope:
+        """The envelope (waiting for the workers, or stepping here when none were started)."""
+        if self._ready is None:
+            assert self._measure is not None
+            data, rest, skeleton = self._measure
+            if self._stepping is not None:
+                stepped = self._stepping.get()
+                self._pool.join()
+                self._pool = None
+            else:
+                stepped = [_step_run(motion, self._ticks) for _, motion in self._runs]
+            envelope = _summarise(data, rest, skeleton, *_recorded(self._runs, self._ticks, stepped))
+            path = default_cache_root() / "envelope" / f"{self._key}.json"
+            path.parent.mkdir(parents=True, exist_ok=True)
+            staging = path.with_suffix(f".{os.getpid()}.tmp")
+            staging.write_text(_to_json(envelope))
+            staging.replace(path)
+            _MEMORY[self._key] = envelope
+            self._ready = envelope
+        return self._ready
+
+
+def start_pose_envelope(spec: CharacterSpec, rig: CompiledRig) -> PendingEnvelope:
+    """``pose_envelope`` started: from memory or disk when there, else its runs stepping in forked workers
+    (where fork and more than one CPU are available) until ``result()`` is asked. It must be started
+    before anything starts a GPU device's threads (forking after that is unsafe); a spec whose motion
+    cannot be stepped raises MotionRangeError here, before any work."""
     skeleton = build_skeleton(spec, rig)
     data = build_motion(spec, rig, skeleton)
     key = hashlib.sha256(
         json.dumps(data, sort_keys=True).encode() + rig.slots.tobytes() + source_digest().encode()
     ).hexdigest()
     if key in _MEMORY:
-        return _MEMORY[key]
+        return PendingEnvelope(key, _MEMORY[key])
     path = default_cache_root() / "envelope" / f"{key}.json"
     if path.is_file():
         envelope = _from_json(path.read_text())
-    else:
-        envelope = measure_envelope(data, rig.slots, skeleton)
-        path.parent.mkdir(parents=True, exist_ok=True)
-        staging = path.with_suffix(f".{os.getpid()}.tmp")
-        staging.write_text(_to_json(envelope))
-        staging.replace(path)
-    _MEMORY[key] = envelope
-    return envelope
+        _MEMORY[key] = envelope
+        return PendingEnvelope(key, envelope)
+    return PendingEnvelope(key, None, (data, rig.slots, skeleton))

@@ -22,7 +22,7 @@ from .. import __version__
 from ..candidates import TIERS, CandidateSet, TierRejectedError, build_candidates, skin_note
 from ..field import layout as col
 from ..field.floors import floors_for
-from ..motion.envelope import pose_envelope
+from ..motion.envelope import PendingEnvelope, start_pose_envelope
 from ..rig import CompiledRig
 from ..rig.signatures import signatures as rig_signatures
 from ..spec import CharacterSpec
@@ -58,6 +58,7 @@ from .skin_tier import (
     skin_contract,
     skin_departures,
 )
+from .subdivide import analytic_normals, subdivide_to_field
 from .topology import components
 from .weights import SkinWeights, skin_weights
 
@@ -80,7 +81,8 @@ FACE_NORMAL_MAX_DEG = 60.0
 #: Vertices within this many lattice cells of a hard-min crease between two blend roots are left out of
 #: the normal gates: the analytic normal itself jumps there, so no mesh normal can agree with it.
 CREASE_BAND_CELLS = 2.0
-#: The mesh gates an edge flip can mend (surface/flips.py), tried before a finer lattice.
+#: The mesh gates an edge flip (surface/flips.py) and a local subdivision (surface/subdivide.py) can mend,
+#: tried in that order before a finer lattice.
 NORMAL_GATES = frozenset(
     {"vertexNormalAngleMax", "vertexNormalAngleP99", "faceNormalAngleMax", "faceNormalAngleP99", "inverted"}
 )
@@ -93,6 +95,14 @@ EXTRA_REFINEMENTS = 3
 SMALL_LATTICE_NODES = 2_000_000
 #: Calibration points for picking the faster sampling backend.
 CALIBRATION_POINTS = 32768
+#: wgpu's start-up before its first sample (adapter, device, wgpu-native's cffi type parsing, the first
+#: pipeline): 3.1 s to 4.2 s measured in a cProfile'd build on the 2-core machine under load, so 2 s is
+#: a floor. Against numpy's 0.3 µs per point that is several million samples.
+WGPU_STARTUP_S = 2.0
+#: Nodes a build may sample per node of its first lattice: the narrow band holds 15-35 % of a dense
+#: lattice (the sampling report's "% of a dense pass"), and the refinement budget allows two √2 finer
+#: lattices (2^1.5 and 2^3 times the nodes): 0.35 · (1 + 2.83 + 8) ≈ 4.1.
+SAMPLED_NODES_PER_FIRST_NODE = 4.1
 #: Candidate index written for a vertex no candidate region covers (it is never corrected).
 NO_PROGRAM = 65535
 #: Candidate index of a vertex that evaluates no field at all (a skin-represented tier, TIER_REPRESENTATION):
@@ -142,8 +152,14 @@ class SurfaceBuild:
         return all(g.passed for g in self.gates)
 
 
-def choose_backend(rig: CompiledRig, requested: str, progress: Progress) -> tuple[FieldBackend, str]:
-    """The requested backend, or for "auto" the faster of numpy and wgpu measured on this machine."""
+def choose_backend(
+    rig: CompiledRig, requested: str, progress: Progress, tier: str = DEFAULT_TIER
+) -> tuple[FieldBackend, str]:
+    """The requested backend, or for "auto" the faster of numpy and wgpu measured on this machine.
+
+    Faster for the whole build, start-up included: wgpu pays WGPU_STARTUP_S before its first sample, so
+    when numpy is predicted to finish every lattice the build may sample in less than that, wgpu is not
+    started at all. Otherwise both are timed on the same points and the faster per point is chosen."""
     if requested != "auto":
         if requested not in BACKENDS:
             raise BackendChoiceError(f"--backend: unknown {requested!r}; choose auto, {', '.join(BACKENDS)}")
@@ -154,6 +170,19 @@ def choose_backend(rig: CompiledRig, requested: str, progress: Progress) -> tupl
     hi = np.max(np.maximum(rig.slots[:, col.A], rig.slots[:, col.B]), axis=0)
     points = rng.uniform(lo, hi, (CALIBRATION_POINTS, 3)).astype(np.float32)
     t_numpy = time_backend(numpy_backend, points, repeats=2)
+    try:
+        nodes = float(np.prod(make_grid(rig.slots, rig.graph, tier, rig.slot_parts, 0).shape))
+    except GridTooFineError:
+        nodes = math.inf
+    predicted = t_numpy / CALIBRATION_POINTS * nodes * SAMPLED_NODES_PER_FIRST_NODE
+    if predicted < WGPU_STARTUP_S:
+        why = (
+            f"numpy predicted {predicted:.2f} s for every lattice the build may sample, under wgpu's "
+            f"{WGPU_STARTUP_S:g} s start-up ({CALIBRATION_POINTS}-point calibration: numpy "
+            f"{t_numpy * 1e3:.1f} ms)"
+        )
+        progress(f"sampling backend numpy ({why})")
+        return numpy_backend, why
     try:
         gpu = make_backend("wgpu", rig.graph, rig.slots)
         t_gpu = time_backend(gpu, points, repeats=2)
@@ -334,7 +363,8 @@ def _fail_on(gates: list[SurfaceGate], where: str, remedy: str = "") -> None:
 def _mesh_remedy(refinement: int, spacing: float) -> str:
     """What the build tried for a mesh gate, and what the user can change (the gate names the place)."""
     return (
-        f"; refining the lattice did not help (the best lattice tried, refinement {refinement} at "
+        f"; flipping edges, splitting triangles toward the field and refining the lattice did not help "
+        f"(the best lattice tried, refinement {refinement} at "
         f"h = {spacing:.3g} m, is reported): a feature there is thinner or tighter than the lattice "
         "resolves; thicken the part named, or widen the blend k (or the gap) where it meets its neighbour"
     )
@@ -547,6 +577,15 @@ def _one_lattice(
                 + ("" if ex is flipped_ex else " (not kept)")
             )
         timings["validation"] += time.perf_counter() - t
+    if failed and set(failed) <= NORMAL_GATES:
+        # Remedy before refining the whole lattice: split the triangles where the normals disagree (not
+        # when the topology or the distances fail too: only a finer lattice mends those).
+        t = time.perf_counter()
+        ex, gates, policy, failed = _subdivided(
+            rig, ex, gates, policy, failed, rest_field, skeleton, grid, progress
+        )
+        mesh = ex.mesh
+        timings["validation"] += time.perf_counter() - t
     sampling = SamplingReport(
         chosen.name,
         why,
@@ -559,6 +598,38 @@ def _one_lattice(
         timings["sampling"],
     )
     return ValidatedMesh(ex, gates, policy, grid, refinement, sampling, timings)
+
+
+def _subdivided(
+    rig: CompiledRig,
+    ex: Extraction,
+    gates: list[SurfaceGate],
+    policy: ComponentPolicy,
+    failed: list[str],
+    rest_field: BodyField,
+    skeleton: Skeleton,
+    grid: Grid,
+    progress: Progress,
+) -> tuple[Extraction, list[SurfaceGate], ComponentPolicy, list[str]]:
+    """The extraction split locally toward the field (surface/subdivide.py) when that leaves fewer mesh
+    gates failing (or the same ones no worse in number), else the one given."""
+    mesh, added, declined = subdivide_to_field(ex.mesh, rest_field.field)
+    if added == 0:
+        return ex, gates, policy, failed
+    normals = analytic_normals(mesh, rest_field.gradient)
+    residual = float(np.max(np.abs(rest_field.distance(mesh.vertices[ex.mesh.vertex_count :]))))
+    split = replace(ex, mesh=mesh, normals=normals, residual=max(ex.residual, residual))
+    again, again_policy = surface_mesh_gates(rig, split, rest_field, skeleton, grid.spacing)
+    still = [g.name for g in again if not g.passed]
+    kept = len(still) < len(failed) or (len(still) == len(failed) and set(still) <= set(failed))
+    progress(
+        f"{added} edges split toward the field where the normals disagree ({declined} marked triangles "
+        f"declined: a midpoint there would not reach the zero set): mesh gates "
+        f"{len(again) - len(still)}/{len(again)} passed"
+        + (f"; failed {still}" if still else "")
+        + ("" if kept else " (not kept)")
+    )
+    return (split, again, again_policy, still) if kept else (ex, gates, policy, failed)
 
 
 def build_surface(
@@ -609,24 +680,42 @@ def _extract_surface(
     progress: Progress,
     strict: bool,
 ) -> SurfaceBuild:
-    """Extract, gate, weight, choose deformations and correct: the cold path of build_surface."""
+    """Extract, gate, weight, choose deformations and correct: the cold path of build_surface.
+
+    The motion envelope is started first: its runs step in forked workers (motion/envelope.py) while this
+    process samples, extracts and gates the mesh, which needs no motion; forking is safe only before the
+    sampling backend has started a GPU device's threads. The skin weights are the first to wait for it."""
+    with start_pose_envelope(spec, rig) as pending:
+        return _extract_with(spec, rig, key, tier, backend, cache, progress, strict, pending)
+
+
+def _extract_with(
+    spec: CharacterSpec,
+    rig: CompiledRig,
+    key: _Key,
+    tier: str,
+    backend: str,
+    cache: SurfaceCache | None,
+    progress: Progress,
+    strict: bool,
+    pending: PendingEnvelope,
+) -> SurfaceBuild:
+    """``_extract_surface`` with its envelope under way."""
     geometry, settings, extra = key.geometry, key.settings, key.extra
     t0 = time.perf_counter()
-    # The envelope first: it may step its runs in forked processes (motion/envelope.py), which is safe
-    # only before the sampling backend has started a GPU device's threads.
-    envelope = pose_envelope(spec, rig)
-    envelope_seconds = time.perf_counter() - t0
-    progress(
-        f"motion envelope: {len(envelope.runs)} runs × {envelope.ticks} ticks "
-        f"({envelope.samples:,} poses measured)"
-    )
-    chosen, why = choose_backend(rig, backend, progress)
+    chosen, why = choose_backend(rig, backend, progress, tier)
     rest_field = BodyField(rig.graph, rig.slots)
     skeleton = build_skeleton(spec, rig)
     validated = validated_mesh(rig, skeleton, tier, chosen, why, progress)
     ex, gates, policy, grid = validated.extraction, validated.gates, validated.policy, validated.grid
     mesh, refinement, sampling, timings = ex.mesh, validated.refinement, validated.sampling, validated.timings
-    timings["envelope"] = envelope_seconds
+    t = time.perf_counter()
+    envelope = pending.result()
+    timings["envelope"] = time.perf_counter() - t
+    progress(
+        f"motion envelope: {len(envelope.runs)} runs × {envelope.ticks} ticks "
+        f"({envelope.samples:,} poses measured; waited {timings['envelope']:.2f} s after the mesh)"
+    )
     if policy.detached:
         progress(f"declared: {', '.join(policy.detached)} detached from the body (the field leaves a gap)")
     if strict:

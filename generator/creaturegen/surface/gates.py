@@ -17,7 +17,8 @@ Every threshold is a parameter. Defaults:
   face normals ``FACE_NORMAL_MAX_DEG``/``FACE_NORMAL_P99_DEG`` (30°/10°). Face maxima are looser because
   a sliver's normal follows its chord, not the surface. Area weighting biases vertex normals on the
   irregular fans marching cubes makes (a 5-cells-per-radius torus reaches p99 ≈ 5°, max ≈ 5.5°, while
-  its face normals stay under 4°), hence the 5° p99.
+  its face normals stay under 4°), hence the 5° p99. The p99s are over surface area, not element count
+  (``_angle_gates``), so a mesh refined locally is judged by the same surface fraction.
 
 The zero-set→mesh gate only sees the zero set that Newton reaches from its seeds: within
 ``SEED_OFFSET_FACTOR``·L of the mesh, or inside the mesh's box padded by ``BOX_PADDING_FACTOR``·L. A
@@ -376,12 +377,37 @@ def intersection_gates(mesh: Mesh, bvh: BVH) -> list[SurfaceGate]:
     ]
 
 
+def weighted_percentile(values: F64, weights: F64, percent: float) -> float:
+    """The smallest value below which ``percent`` % of the total weight lies (inverted CDF)."""
+    if values.size == 0:
+        return 0.0
+    order = np.argsort(values, kind="stable")
+    cumulative = np.cumsum(weights[order])
+    at = int(np.searchsorted(cumulative, percent / 100.0 * cumulative[-1], side="left"))
+    return float(values[order][min(at, values.size - 1)])
+
+
+def vertex_areas(mesh: Mesh) -> F64:
+    """A third of the area of every face around each vertex (the vertex's share of the surface)."""
+    third = np.linalg.norm(mesh.face_normals(), axis=1) / 6.0
+    out = np.zeros(mesh.vertex_count)
+    for k in range(3):
+        np.add.at(out, mesh.faces[:, k], third)
+    return out
+
+
 def _angle_gates(
-    prefix: str, angles: F64, ids: I64, points: F64, max_deg: float, p99_deg: float
+    prefix: str, angles: F64, ids: I64, points: F64, areas: F64, max_deg: float, p99_deg: float
 ) -> list[SurfaceGate]:
-    """Max and p99 of the normal angles; both point at the worst one (where the tail is heaviest)."""
+    """Max and p99 of the normal angles; both point at the worst one (where the tail is heaviest).
+
+    The p99 is over surface area (each vertex weighted by its share of the area, each face by its own),
+    not over element count: it bounds the fraction of the surface whose shading normal departs, which is
+    what a viewer sees, and it does not depend on where the mesh is dense. On a lattice's mesh the two
+    agree (marching cubes spreads vertices evenly); after local subdivision (surface/subdivide.py) a count
+    would rise with every vertex added where the surface bends, although every angle there fell."""
     worst = float(np.max(angles)) if angles.size else 0.0
-    p99 = float(np.percentile(angles, 99.0)) if angles.size else 0.0
+    p99 = weighted_percentile(angles, areas, 99.0)
     at = int(ids[np.argmax(angles)]) if angles.size else -1
     where = _point(points[np.argmax(angles)]) if angles.size else None
     return [
@@ -452,6 +478,8 @@ def field_gates(
         face_ids, feet, fn, at_feet = face_ids[keep], feet[keep], fn[keep], at_feet[keep]
     vertex_angles = angles_deg(normals[used], gradient(mesh.vertices[used]))
     face_angles = angles_deg(fn, at_feet)
+    v_areas = vertex_areas(mesh)[used]
+    f_areas = np.linalg.norm(fn, axis=1)
 
     vmax, vp99, fmax, fp99 = normal_limits
     return [
@@ -472,6 +500,6 @@ def field_gates(
             _point(samples[far]) if far >= 0 else None,
         ),
         SurfaceGate("zeroSetToMesh", coverage, coverage_tol, "L", "max", coverage_detail, coverage_at),
-        *_angle_gates("vertex", vertex_angles, used, mesh.vertices[used], vmax, vp99),
-        *_angle_gates("face", face_angles, face_ids, feet, fmax, fp99),
+        *_angle_gates("vertex", vertex_angles, used, mesh.vertices[used], v_areas, vmax, vp99),
+        *_angle_gates("face", face_angles, face_ids, feet, f_areas, fmax, fp99),
     ]

@@ -63,7 +63,16 @@ class Contact:
             else f"the blend bridges the {self.gap:.3g} m between their primitives"
         )
         joint = "their joint" if self.joined else "not joined in the skeleton"
-        return f"{self.a} touches {self.b} ({joint}; {how} at rest)"
+        change = (
+            ""
+            if self.joined
+            else (
+                f": move them apart (hip, pose or size) by over {-self.gap:.3g} m plus their blend width k"
+                if self.gap < 0
+                else f": move them further apart, or give one a k (or kCap) below {self.gap:.3g} m"
+            )
+        )
+        return f"{self.a} touches {self.b} ({joint}; {how} at rest){change}"
 
 
 def surface_genus(mesh: Mesh) -> float:

@@ -1,0 +1,193 @@
+"""Local subdivision toward the field: the remedy for mesh-normal gates where the surface bends within a cell.
+
+A blend fillet (a small part sunk into a bigger one, a leg meeting a hip with a small k) turns the true
+normal within one or two lattice cells. Marching cubes samples it at the lattice's pitch everywhere, so
+the triangles there chord across the bend and their normals (and their vertices' area-weighted normals)
+depart from the field's by tens of degrees. A √2 finer lattice halves that chord everywhere at eight
+times the sampling cost, and can change the topology elsewhere (two parts a finer lattice separates).
+
+This module halves it only where the normals disagree: the longest edge of a marked triangle gets a
+midpoint, moved onto the zero set along its ends' normals, and the split is closed by Rivara's
+longest-edge refinement (a neighbour that shares a split edge splits its own longest edge too, so no
+T-junction is left and no angle falls below half its parent's). The surface stays closed and manifold
+with the same Euler characteristic (each split adds a vertex, three edges and two faces). Existing
+vertices do not move. The mesh gates judge the result as they judged the lattice's.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+
+import numpy as np
+import numpy.typing as npt
+
+from .mesh import Mesh, angles_deg, unit_rows
+
+F64 = npt.NDArray[np.float64]
+I64 = npt.NDArray[np.int64]
+FieldFn = Callable[[F64], tuple[F64, F64]]
+
+#: Vertices whose area-weighted normal departs from ∇d by more than this are marked (degrees): twice
+#: the p99 bound of surface/gates.py, so the tail that decides the p99 gate is refined and the bulk is not.
+MARK_VERTEX_DEG = 10.0
+#: Faces whose normal departs from ∇d at the centroid by more than this are marked (degrees).
+MARK_FACE_DEG = 20.0
+#: Rounds at most: a longest-edge split halves a triangle, so two rounds halve the chord across a fillet;
+#: eight take a one-cell fillet to a sixteenth of a cell (the fixture of tests/test_subdivide.py needs them).
+LEVELS = 8
+#: Newton steps for a midpoint along its edge's normal line, clamped to MAX_MOVE of the edge's length; a
+#: midpoint counts as arrived within PROJECT_TOL of the edge's length of the zero set.
+NEWTON_STEPS = 6
+PROJECT_TOL = 1e-3
+MAX_MOVE = 0.5
+#: Below this |∇d · direction| the line runs along the surface: no Newton step is taken.
+SLOPE_FLOOR = 0.1
+#: Closures taken again without the marked faces around midpoints that did not arrive, before the round
+#: gives up (each retry only shrinks the marked set).
+RETRIES = 12
+#: Ends whose normals are further apart than this (cos 120°) face apart: their mean points nowhere useful.
+OPPOSED_COS = -0.5
+
+
+def normal_departures(mesh: Mesh, gradient: Callable[[F64], F64]) -> tuple[F64, F64]:
+    """(vertex, face) angles in degrees between the mesh normals and ∇d (at vertices and centroids)."""
+    fn = mesh.face_normals()
+    vn = np.zeros((mesh.vertex_count, 3))
+    for k in range(3):
+        np.add.at(vn, mesh.faces[:, k], fn)
+    vertex = angles_deg(vn, gradient(mesh.vertices))
+    face = angles_deg(fn, gradient(mesh.corners().mean(axis=1)))
+    return vertex, face
+
+
+def _edge_keys(faces: I64, count: int) -> I64:
+    """(F, 3) undirected key of edge k of each face (corner k to corner k+1)."""
+    a, b = faces, np.roll(faces, -1, axis=1)
+    result: I64 = np.minimum(a, b) * count + np.maximum(a, b)
+    return result
+
+
+def _longest(vertices: F64, faces: I64, keys: I64) -> I64:
+    """(F,) which edge of each face is its longest; ties go to the smaller edge key, so two faces
+    sharing an edge agree on its rank (the closure below relies on one global order of edges)."""
+    c = vertices[faces]
+    length = np.linalg.norm(np.roll(c, -1, axis=1) - c, axis=2)
+    order = np.lexsort((keys.ravel(), -length.ravel()))  # longest first, then smaller key
+    rank = np.empty(order.size, dtype=np.int64)
+    rank[order] = np.arange(order.size)
+    result: I64 = np.argmin(rank.reshape(faces.shape), axis=1)
+    return result
+
+
+def _close_marks(keys: I64, longest: I64, marked: I64) -> npt.NDArray[np.bool_]:
+    """(F, 3) split flags: the marked edges, closed so that every face with a split edge splits its
+    longest edge too (Rivara's longest-edge refinement: the children's angles stay bounded below by
+    half the parent's, where repeated green bisection would grind a fillet into slivers)."""
+    rows = np.arange(keys.shape[0])
+    while True:
+        split = np.isin(keys, marked)
+        missing = split.any(axis=1) & ~split[rows, longest]
+        if not missing.any():
+            return split
+        marked = np.union1d(marked, keys[missing, longest[missing]])
+
+
+def _midpoints(start: F64, end: F64, field: FieldFn) -> tuple[F64, npt.NDArray[np.bool_]]:
+    """Each edge's midpoint moved onto the zero set along the mean of its ends' unit normals (Newton on
+    the distance along that line), and whether it arrived (not where the ends face apart: the mean of
+    two opposed normals points nowhere). Moving along the ends' normals, not along ∇d
+    at the midpoint, keeps the point over its own chord: inside a concave fillet ∇d points at one of the
+    two sheets, and following it would slide the point sideways and fold its triangles."""
+    chord = 0.5 * (start + end)
+    length = np.linalg.norm(end - start, axis=1)
+    ends = unit_rows(field(start)[1]), unit_rows(field(end)[1])
+    direction = unit_rows(ends[0] + ends[1])
+    t = np.zeros(chord.shape[0])
+    for _ in range(NEWTON_STEPS):
+        d, g = field(chord + t[:, None] * direction)
+        slope = np.einsum("ij,ij->i", g, direction)
+        step = np.where(np.abs(slope) > SLOPE_FLOOR, d / np.where(slope == 0.0, 1.0, slope), 0.0)
+        t = np.clip(t - step, -MAX_MOVE * length, MAX_MOVE * length)
+    moved = chord + t[:, None] * direction
+    d, _ = field(moved)
+    ok = (np.abs(d) <= PROJECT_TOL * length) & (np.einsum("ij,ij->i", ends[0], ends[1]) > OPPOSED_COS)
+    return moved, ok
+
+
+def split_faces(mesh: Mesh, marked_faces: I64, field: FieldFn) -> tuple[Mesh, int, int]:
+    """The mesh with the longest edge of every face in ``marked_faces`` split at its zero-set midpoint,
+    closed by longest-edge refinement (no T-junction is left); returns (mesh, vertices added, marked
+    faces declined). A midpoint that cannot reach the zero set (an edge across a crease or a thin tip)
+    is never left on its chord, where it would stand off the surface as a spike: the marked faces
+    around it are declined and the closure is taken again without them."""
+    faces = mesh.faces.astype(np.int64)
+    vertices = mesh.vertices
+    count = vertices.shape[0]
+    keys = _edge_keys(faces, count)
+    longest = _longest(vertices, faces, keys)
+    rows = np.arange(faces.shape[0])
+    marked = np.unique(marked_faces)
+    stuck = np.zeros(count, dtype=bool)
+    for _ in range(RETRIES):
+        split = _close_marks(keys, longest, np.unique(keys[marked, longest[marked]]))
+        edges = np.unique(keys[split])
+        if edges.size == 0:
+            return mesh, 0, int(np.unique(marked_faces).size)
+        mids, ok = _midpoints(vertices[edges // count], vertices[edges % count], field)
+        if ok.all():
+            break
+        # Decline the marked faces around the stuck ends, one ring wider on every retry: a closure can
+        # reach a stuck edge from a marked face a few triangles away (along its longest-edge path).
+        stuck[edges[~ok] // count] = True
+        stuck[edges[~ok] % count] = True
+        stuck[faces[stuck[faces].any(axis=1)].ravel()] = True
+        marked = marked[~stuck[faces[marked]].any(axis=1)]
+    else:
+        return mesh, 0, int(np.unique(marked_faces).size)
+    declined = int(np.unique(marked_faces).size - marked.size)
+    mid = np.where(split, count + np.searchsorted(edges, keys), -1)  # (F, 3) midpoint of edge k, or -1
+
+    # Rotate every face so its longest edge comes first: (a, b) longest, c opposite, m its midpoint;
+    # p splits (b, c) and q splits (c, a) where those are split too.
+    turn = (longest[:, None] + np.arange(3)) % 3
+    v, m, s = faces[rows[:, None], turn], mid[rows[:, None], turn], split[rows[:, None], turn]
+    a, b, c, mab, p, q = v[:, 0], v[:, 1], v[:, 2], m[:, 0], m[:, 1], m[:, 2]
+    whole = ~s[:, 0]
+    out = [faces[whole]]
+    left = s[:, 0] & ~s[:, 2]  # (a, m, c) stays whole
+    right = s[:, 0] & ~s[:, 1]  # (m, b, c) stays whole
+    out.append(np.stack((a, mab, c), axis=1)[left])
+    out.append(np.stack((mab, b, c), axis=1)[right])
+    two = s[:, 0] & s[:, 2]
+    out += [np.stack((a, mab, q), axis=1)[two], np.stack((mab, c, q), axis=1)[two]]
+    two = s[:, 0] & s[:, 1]
+    out += [np.stack((mab, b, p), axis=1)[two], np.stack((mab, p, c), axis=1)[two]]
+    new_faces = np.concatenate(out).astype(mesh.faces.dtype)
+    return Mesh(np.concatenate([vertices, mids]), new_faces), int(edges.size), declined
+
+
+def subdivide_to_field(mesh: Mesh, field: FieldFn, levels: int = LEVELS) -> tuple[Mesh, int, int]:
+    """Up to ``levels`` rounds of ``split_faces`` on the faces whose normal, or a corner's, departs from
+    the field past the marking angles; returns (mesh, vertices added, marked faces declined)."""
+    added = declined = 0
+
+    def gradient(p: F64) -> F64:
+        return field(p)[1]
+
+    for _ in range(levels):
+        vertex, face = normal_departures(mesh, gradient)
+        bad_vertex = vertex > MARK_VERTEX_DEG
+        marked = np.flatnonzero((face > MARK_FACE_DEG) | bad_vertex[mesh.faces].any(axis=1))
+        if marked.size == 0:
+            break
+        mesh, more, off = split_faces(mesh, marked, field)
+        added += more
+        declined += off
+        if more == 0:
+            break
+    return mesh, added, declined
+
+
+def analytic_normals(mesh: Mesh, gradient: Callable[[F64], F64]) -> F64:
+    """Unit ∇d at every vertex (what Extraction.normals holds for the lattice's vertices)."""
+    return unit_rows(gradient(mesh.vertices))
