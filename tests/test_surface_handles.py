@@ -20,7 +20,7 @@ from creaturegen.field import layout as col
 from creaturegen.rig import compile_rig
 from creaturegen.spec import CharacterSpec, load_spec
 from creaturegen.surface.build import SurfaceRejectedError, build_surface
-from creaturegen.surface.handles import Contact, handle_contacts, primitive_gap, surface_genus
+from creaturegen.surface.handles import Contact, _pieces, handle_contacts, primitive_gap, surface_genus
 from creaturegen.surface.mesh import Mesh
 from creaturegen.surface.skeleton import build_skeleton
 
@@ -133,3 +133,21 @@ def test_the_cli_exits_3_and_writes_nothing(tmp_path: Path) -> None:
     assert "gate euler" in done.stderr
     assert "part.claw-right touches part.claw-left" in done.stderr
     assert not out.exists() or not any(out.iterdir())
+
+
+def test_a_joined_pair_touching_again_is_a_culprit() -> None:
+    """A child that meets its parent at the joint and again elsewhere (a thigh folded against the belly)
+    closes a loop through one joint: its contact strip comes in two pieces, and the message says so."""
+    torus = _torus()
+    centroid = torus.vertices[torus.faces].mean(axis=1)
+    angle = np.arctan2(centroid[:, 1], centroid[:, 0])
+    two = (np.abs(angle) < 0.2) | (np.abs(np.abs(angle) - np.pi) < 0.2)
+    assert _pieces(torus.faces[two]) == 2
+    assert _pieces(torus.faces[np.abs(angle) < 0.2]) == 1
+    again = Contact("part.thigh", "part.body", 1.0, True, -0.01, -0.02, places=2)
+    assert again.culprit
+    assert "part.thigh touches part.body (at their joint and in 1 more place)" in again.describe()
+    assert not Contact("part.thigh", "part.body", 1.0, True, -0.01, -0.02).culprit
+    apart = Contact("part.leg-a", "part.leg-b", 1.0, False, 0.02, 0.01)
+    assert apart.culprit
+    assert "give one a k (or kCap) below 0.02 m" in apart.describe()

@@ -26,13 +26,14 @@ def test_extra_refinements_only_while_the_lattice_is_small() -> None:
 
 
 def test_a_lower_tier_may_refine_as_far_as_the_hero_would() -> None:
-    """The distant lattice starts two √2 refinements coarser than the hero's (sagitta target 0.25 vs 0.06),
-    the repeated one one: their budgets count from the hero's first lattice."""
+    """The distant lattice starts two √2 refinements coarser than the hero's (sagitta target 0.24 vs 0.06),
+    the repeated one one: their budgets count from the hero's first lattice, and their lattices are the
+    hero's node for node, so a refinement the hero passes the lower tiers reach and pass too."""
     from conftest import EXAMPLES
     from creaturegen.rig import compile_rig
     from creaturegen.spec import CharacterSpec, load_spec
     from creaturegen.surface.build import tier_offset
-    from creaturegen.surface.grid import ERROR_TARGET, spacing_for
+    from creaturegen.surface.grid import ERROR_TARGET, make_grid, spacing_for
 
     spec = load_spec(EXAMPLES / "reference" / "hopper.json")
     assert isinstance(spec, CharacterSpec)
@@ -50,8 +51,14 @@ def test_a_lower_tier_may_refine_as_far_as_the_hero_would() -> None:
     # The offset is the spacing ratio in √2 steps, to the nearest step.
     for tier in ("repeated", "distant"):
         steps = 2.0 * np.log2(spacing_for(slots, tier) / spacing_for(slots, "hero"))
-        assert abs(steps - tier_offset(tier)) < 0.1
+        assert abs(steps - tier_offset(tier)) < 1e-9
         assert ERROR_TARGET[tier] > ERROR_TARGET["hero"]
+    rig = compile_rig(spec)
+    for refinement in range(3):
+        hero = make_grid(rig.slots, rig.graph, "hero", rig.slot_parts, refinement)
+        for tier in ("repeated", "distant"):
+            lower = make_grid(rig.slots, rig.graph, tier, rig.slot_parts, refinement + tier_offset(tier))
+            assert lower == hero, (tier, refinement, lower, hero)
 
 
 def test_a_pointed_tip_starts_at_the_first_lattice_cap_and_refines_up_to_the_limit() -> None:

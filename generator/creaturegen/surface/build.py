@@ -43,7 +43,7 @@ from .extract import Extraction, extract
 from .field64 import BodyField
 from .flips import flip_to_field
 from .gates import DISTANCE_TOL, Direction, SurfaceGate, mesh_gates
-from .grid import ERROR_TARGET, FIRST_CELLS_LIMIT, Grid, GridTooFineError, make_grid
+from .grid import FIRST_CELLS_LIMIT, Grid, GridTooFineError, make_grid, tier_offset
 from .handles import handle_contacts
 from .mesh import Mesh
 from .sampling import sample_band
@@ -420,7 +420,7 @@ def _name_parts(
     and, failing that, the parts of every component that is not a sphere."""
     found = components(mesh)
     bad = [c for c in range(found.count) if int(found.euler[c]) != 2]
-    culprits = [c for c in policy.handles if not c.joined]
+    culprits = [c for c in policy.handles if c.culprit]
     if culprits:
         genus = sum(float(found.genus[c]) for c in bad)
         detail = f"genus {genus:g}, expected 0 (the skeleton is a tree): " + "; ".join(
@@ -454,12 +454,6 @@ class ValidatedMesh:
     refinement: int
     sampling: SamplingReport
     timings: dict[str, float]
-
-
-def tier_offset(tier: str) -> int:
-    """√2 refinements from the tier's first lattice to the hero tier's: h grows with √ε (surface/grid.py),
-    so a tier whose sagitta target is 2ⁿ times the hero's starts n refinements coarser."""
-    return max(round(math.log2(ERROR_TARGET[tier] / ERROR_TARGET[DEFAULT_TIER])), 0)
 
 
 def _may_refine(refinement: int, grid: Grid, tier: str = DEFAULT_TIER) -> bool:

@@ -24,8 +24,13 @@ from ..field import layout as col
 from ..field.primitives import TAPER_EXACT_THRESHOLD
 from ..rig.graph import BlendGraph
 
-#: Surface-error target per tier, as a fraction of the smallest primitive radius (sagitta bound).
-ERROR_TARGET = {"hero": 0.06, "repeated": 0.125, "distant": 0.25}
+#: Surface-error target per tier, as a fraction of the smallest primitive radius (sagitta bound). The
+#: lower tiers' are the hero's times 2 and 4, so their lattices are the hero's one and two √2 steps
+#: coarser, node for node (``make_grid``): a lower tier refined that far extracts the very mesh the hero
+#: does, and no lower tier fails a mesh gate on a lattice the hero passes.
+ERROR_TARGET = {"hero": 0.06, "repeated": 0.12, "distant": 0.24}
+#: The tier whose lattice the others are steps of.
+FINEST_TIER = "hero"
 #: Largest lattice extent along any axis; beyond it the target is unreachable at load-time cost.
 MAX_CELLS_PER_AXIS = 640
 #: Largest first lattice: a body whose sagitta target asks for more starts here, and refinements (each √2
@@ -75,6 +80,12 @@ def spacing_for(slots: npt.NDArray[np.float64], tier: str) -> float:
     return math.sqrt(8.0 * ERROR_TARGET[tier]) * r_min
 
 
+def tier_offset(tier: str) -> int:
+    """√2 refinements from the tier's first lattice to the hero tier's: h grows with √ε, so a tier whose
+    sagitta target is 2ⁿ times the hero's starts n refinements coarser."""
+    return max(round(math.log2(ERROR_TARGET[tier] / ERROR_TARGET[FINEST_TIER])), 0)
+
+
 #: A bound on |∇d| over any body: √(1+s²) for tapered capsules (s ≤ TAPER_EXACT_THRESHOLD), 1 for exact
 #: forms. Polynomial smooth-min and log-sum-exp gradients are convex combinations of their children's, and
 #: a hard min picks one, so no blend raises it.
@@ -112,17 +123,21 @@ def make_grid(
     """The tier's lattice over the body box, padded by two cells and rounded up to whole blocks.
 
     ``refinement`` n divides the spacing by 2^(n/2): the build retries finer when a topology gate fails
-    (a gap between parts narrower than the spacing lets marching cubes bridge it).
+    (a gap between parts narrower than the spacing lets marching cubes bridge it). A lower tier starts
+    ``tier_offset`` steps coarser than the hero's first lattice (after its cap, when the thinnest part
+    would need more than FIRST_CELLS_LIMIT cells), so its lattices are the hero's, further out.
     """
     box_lo, hi = body_box(slots, graph)
     extent = float((hi - box_lo).max())
-    h = spacing_for(slots, tier)
+    # Every tier's spacing is the hero's first spacing times a power of √2, computed from one exponent so
+    # that the repeated tier's refinement n + 1 is the hero's refinement n bit for bit.
+    h = spacing_for(slots, FINEST_TIER)
     limited_by = ""
     if extent / h + 4.0 > FIRST_CELLS_LIMIT:
         _, index = smallest_radius(slots)
         limited_by = f"part.{slot_names[index]}"
         h = extent / (FIRST_CELLS_LIMIT - BLOCK)  # room for the two-cell pads, rounded up to a block
-    h /= 2.0 ** (refinement / 2.0)
+    h /= 2.0 ** ((refinement - tier_offset(tier)) / 2.0)
     lo = box_lo - 2.0 * h
     cells = np.ceil((hi + 2.0 * h - lo) / h).astype(np.int64)
     cells = ((cells + BLOCK - 1) // BLOCK) * BLOCK

@@ -50,6 +50,13 @@ class Contact:
     joined: bool  # skeleton neighbours: the contact is their joint
     gap: float  # primitive-to-primitive distance at rest, m (negative: they overlap by that much)
     bridge: float  # bound on the field's largest value along the segment between the primitives, m
+    places: int = 1  # separate pieces of their contact strip (two for a leg touching its body again)
+
+    @property
+    def culprit(self) -> bool:
+        """A contact to move: between parts the skeleton does not join, or a joined pair that touches
+        again away from its joint (a thigh folded against the belly)."""
+        return not self.joined or self.places > 1
 
     @property
     def certain(self) -> bool:
@@ -63,6 +70,12 @@ class Contact:
             else f"the blend bridges the {self.gap:.3g} m between their primitives"
         )
         joint = "their joint" if self.joined else "not joined in the skeleton"
+        if self.joined and self.places > 1:
+            joint = f"at their joint and in {self.places - 1} more place{'s' if self.places > 2 else ''}"
+            return (
+                f"{self.a} touches {self.b} ({joint}): turn or move the child part so it meets its parent "
+                "only at the joint"
+            )
         change = (
             ""
             if self.joined
@@ -100,6 +113,19 @@ def surface_genus(mesh: Mesh) -> float:
         parts, _ = connected_components(graph, directed=False)
         loops = half.size - used.size + parts
     return (2 * found.count - chi - loops) / 2.0
+
+
+def _pieces(faces: npt.NDArray[np.integer]) -> int:
+    """Connected pieces of a set of faces (joined through shared vertices)."""
+    if faces.shape[0] == 0:
+        return 0
+    used, local = np.unique(faces, return_inverse=True)
+    local = local.reshape(faces.shape)
+    rows = np.concatenate([local[:, 0], local[:, 1]])
+    cols = np.concatenate([local[:, 1], local[:, 2]])
+    graph = coo_matrix((np.ones(rows.size), (rows, cols)), shape=(used.size, used.size))
+    count, _ = connected_components(graph, directed=False)
+    return int(count)
 
 
 def primitive_gap(slots: F64, i: int, j: int) -> float:
@@ -178,5 +204,6 @@ def handle_contacts(
         p, q = _closest_points(slots[a, col.A], slots[a, col.B], slots[b, col.A], slots[b, col.B])
         joined = parent.get(int(i)) == j or parent.get(int(j)) == i
         bridge = bridge_bound(distance, p, q)
-        found.append(Contact(f"part.{parts[i]}", f"part.{parts[j]}", drop, bool(joined), gap, bridge))
+        places = _pieces(mesh.faces[strip])
+        found.append(Contact(f"part.{parts[i]}", f"part.{parts[j]}", drop, bool(joined), gap, bridge, places))
     return tuple(sorted(found, key=lambda c: (c.joined, c.gap, c.a, c.b)))
