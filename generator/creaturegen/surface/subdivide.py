@@ -45,8 +45,10 @@ SLOPE_FLOOR = 0.1
 #: Closures taken again without the marked faces around midpoints that did not arrive, before the round
 #: gives up (each retry only shrinks the marked set).
 RETRIES = 12
-#: Ends whose normals are further apart than this (cos 120°) face apart: their mean points nowhere useful.
-OPPOSED_COS = -0.5
+#: Ends whose normals are further apart than this (cos 150°) face apart across a thin part: their mean
+#: points nowhere useful. A blend crease that the lattice cuts across can turn 120-125° within one edge
+#: (seed 81's leg joint at hero); its bisector is still the way to the fillet, so the bound sits past that.
+OPPOSED_COS = -0.866
 
 
 def normal_departures(mesh: Mesh, gradient: Callable[[F64], F64]) -> tuple[F64, F64]:
