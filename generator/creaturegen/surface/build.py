@@ -562,7 +562,7 @@ def _one_lattice(
             flipped_ex = replace(ex, mesh=flipped_mesh)
             again, again_policy = surface_mesh_gates(rig, flipped_ex, rest_field, skeleton, grid.spacing)
             still = [g.name for g in again if not g.passed]
-            if len(still) < len(failed) or (len(still) == len(failed) and set(still) <= set(failed)):
+            if _no_worse(failed, still):
                 ex, mesh, gates, policy, failed = flipped_ex, flipped_mesh, again, again_policy, still
             progress(
                 f"{flips} edges flipped toward the field: mesh gates {len(again) - len(still)}/{len(again)} "
@@ -594,6 +594,11 @@ def _one_lattice(
     return ValidatedMesh(ex, gates, policy, grid, refinement, sampling, timings)
 
 
+def _no_worse(failed: list[str], still: list[str]) -> bool:
+    """Whether a remedy's mesh is kept: fewer gates fail, or the same number and none that passed before."""
+    return len(still) < len(failed) or (len(still) == len(failed) and set(still) <= set(failed))
+
+
 def _subdivided(
     rig: CompiledRig,
     ex: Extraction,
@@ -615,7 +620,7 @@ def _subdivided(
     split = replace(ex, mesh=mesh, normals=normals, residual=max(ex.residual, residual))
     again, again_policy = surface_mesh_gates(rig, split, rest_field, skeleton, grid.spacing)
     still = [g.name for g in again if not g.passed]
-    kept = len(still) < len(failed) or (len(still) == len(failed) and set(still) <= set(failed))
+    kept = _no_worse(failed, still)
     progress(
         f"{added} edges split toward the field where the normals disagree ({declined} marked triangles "
         f"declined: a midpoint there would not reach the zero set): mesh gates "

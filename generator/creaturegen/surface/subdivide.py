@@ -21,6 +21,7 @@ from collections.abc import Callable
 import numpy as np
 import numpy.typing as npt
 
+from .gates import vertex_normals
 from .mesh import Mesh, angles_deg, unit_rows
 
 F64 = npt.NDArray[np.float64]
@@ -53,12 +54,8 @@ OPPOSED_COS = -0.866
 
 def normal_departures(mesh: Mesh, gradient: Callable[[F64], F64]) -> tuple[F64, F64]:
     """(vertex, face) angles in degrees between the mesh normals and ∇d (at vertices and centroids)."""
-    fn = mesh.face_normals()
-    vn = np.zeros((mesh.vertex_count, 3))
-    for k in range(3):
-        np.add.at(vn, mesh.faces[:, k], fn)
-    vertex = angles_deg(vn, gradient(mesh.vertices))
-    face = angles_deg(fn, gradient(mesh.corners().mean(axis=1)))
+    vertex = angles_deg(vertex_normals(mesh), gradient(mesh.vertices))
+    face = angles_deg(mesh.face_normals(), gradient(mesh.corners().mean(axis=1)))
     return vertex, face
 
 
