@@ -543,9 +543,8 @@ def _one_lattice(
     )
     t = time.perf_counter()
     ex = extract(rest_field, band, rig.body_scale)
-    mesh = ex.mesh
     timings["extraction"] += time.perf_counter() - t
-    progress(f"extracted {mesh.vertex_count:,} vertices, {mesh.face_count:,} triangles")
+    progress(f"extracted {ex.mesh.vertex_count:,} vertices, {ex.mesh.face_count:,} triangles")
     t = time.perf_counter()
     gates, policy = surface_mesh_gates(rig, ex, rest_field, skeleton, grid.spacing)
     timings["validation"] += time.perf_counter() - t
@@ -554,31 +553,15 @@ def _one_lattice(
         f"mesh gates: {len(gates) - len(failed)}/{len(gates)} passed"
         + (f"; failed {failed}" if failed else "")
     )
-    if any(name in NORMAL_GATES for name in failed):
-        # Remedy before refining: triangles that span a bend along the wrong diagonal (surface/flips.py).
+    refining = "euler" in failed and not policy.handles_certain and _may_refine(refinement, grid, tier)
+    if any(name in NORMAL_GATES for name in failed) and not refining:
+        # Not when the genus is wrong and a finer lattice follows anyway: neither remedy changes the
+        # topology, so it cannot spare that lattice, and re-gating a large mesh for it cost seed 88 nine
+        # seconds.
         t = time.perf_counter()
-        flipped_mesh, flips = flip_to_field(mesh, rest_field.gradient)
-        if flips:
-            flipped_ex = replace(ex, mesh=flipped_mesh)
-            again, again_policy = surface_mesh_gates(rig, flipped_ex, rest_field, skeleton, grid.spacing)
-            still = [g.name for g in again if not g.passed]
-            if _no_worse(failed, still):
-                ex, mesh, gates, policy, failed = flipped_ex, flipped_mesh, again, again_policy, still
-            progress(
-                f"{flips} edges flipped toward the field: mesh gates {len(again) - len(still)}/{len(again)} "
-                f"passed"
-                + (f"; failed {still}" if still else "")
-                + ("" if ex is flipped_ex else " (not kept)")
-            )
-        timings["validation"] += time.perf_counter() - t
-    if failed and set(failed) <= NORMAL_GATES:
-        # Remedy before refining the whole lattice: split the triangles where the normals disagree (not
-        # when the topology or the distances fail too: only a finer lattice mends those).
-        t = time.perf_counter()
-        ex, gates, policy, failed = _subdivided(
+        ex, gates, policy, failed = _remedied(
             rig, ex, gates, policy, failed, rest_field, skeleton, grid, progress
         )
-        mesh = ex.mesh
         timings["validation"] += time.perf_counter() - t
     sampling = SamplingReport(
         chosen.name,
@@ -599,7 +582,10 @@ def _no_worse(failed: list[str], still: list[str]) -> bool:
     return len(still) < len(failed) or (len(still) == len(failed) and set(still) <= set(failed))
 
 
-def _subdivided(
+Remedy = tuple[Extraction, list[SurfaceGate], ComponentPolicy, list[str]]
+
+
+def _remedied(
     rig: CompiledRig,
     ex: Extraction,
     gates: list[SurfaceGate],
@@ -609,26 +595,81 @@ def _subdivided(
     skeleton: Skeleton,
     grid: Grid,
     progress: Progress,
-) -> tuple[Extraction, list[SurfaceGate], ComponentPolicy, list[str]]:
-    """The extraction split locally toward the field (surface/subdivide.py) when that leaves fewer mesh
-    gates failing (or the same ones no worse in number), else the one given."""
+) -> Remedy:
+    """The local remedies for mesh-normal gates, before a whole finer lattice: edge flips toward the field
+    (triangles spanning a bend along the wrong diagonal, surface/flips.py), then splits where the normals
+    still disagree (surface/subdivide.py; only when the topology and the distances pass, which only a
+    finer lattice mends). Each is kept only when it is ``_no_worse``. When only normal gates fail, both
+    are applied and their sum is gated once (one gate pass on a 240k-vertex mesh takes ~15 s); the flips
+    alone are gated only when the sum is not kept."""
+    flipped_mesh, flips = flip_to_field(ex.mesh, rest_field.gradient)
+    flipped = replace(ex, mesh=flipped_mesh)
+    tried_split = False
+    if set(failed) <= NORMAL_GATES:
+        tried_split = True
+        split, added, declined = _split_toward_field(flipped, rest_field)
+        if added:
+            kept, result = _judged(rig, split, gates, policy, failed, rest_field, skeleton, grid)
+            progress(
+                f"{flips} edges flipped and {added} split toward the field where the normals disagree "
+                f"({declined} marked triangles declined: a midpoint there would not reach the zero set): "
+                + _verdict(result, kept)
+            )
+            if kept:
+                return result
+    if flips:
+        kept, result = _judged(rig, flipped, gates, policy, failed, rest_field, skeleton, grid)
+        progress(f"{flips} edges flipped toward the field: " + _verdict(result, kept))
+        if kept:
+            ex, gates, policy, failed = result
+    if failed and set(failed) <= NORMAL_GATES and not tried_split:
+        split, added, declined = _split_toward_field(ex, rest_field)
+        if added:
+            kept, result = _judged(rig, split, gates, policy, failed, rest_field, skeleton, grid)
+            progress(
+                f"{added} edges split toward the field where the normals disagree ({declined} marked "
+                f"triangles declined: a midpoint there would not reach the zero set): "
+                + _verdict(result, kept)
+            )
+            if kept:
+                return result
+    return ex, gates, policy, failed
+
+
+def _split_toward_field(ex: Extraction, rest_field: BodyField) -> tuple[Extraction, int, int]:
+    """The extraction split locally toward the field (surface/subdivide.py), with its analytic normals and
+    residual; returns (extraction, vertices added, marked faces declined)."""
     mesh, added, declined = subdivide_to_field(ex.mesh, rest_field.field)
     if added == 0:
-        return ex, gates, policy, failed
+        return ex, 0, declined
     normals = analytic_normals(mesh, rest_field.gradient)
     residual = float(np.max(np.abs(rest_field.distance(mesh.vertices[ex.mesh.vertex_count :]))))
-    split = replace(ex, mesh=mesh, normals=normals, residual=max(ex.residual, residual))
-    again, again_policy = surface_mesh_gates(rig, split, rest_field, skeleton, grid.spacing)
+    return replace(ex, mesh=mesh, normals=normals, residual=max(ex.residual, residual)), added, declined
+
+
+def _judged(
+    rig: CompiledRig,
+    candidate: Extraction,
+    gates: list[SurfaceGate],
+    policy: ComponentPolicy,
+    failed: list[str],
+    rest_field: BodyField,
+    skeleton: Skeleton,
+    grid: Grid,
+) -> tuple[bool, Remedy]:
+    """A remedied extraction gated again: (kept, its result), kept when ``_no_worse`` than ``failed``."""
+    again, again_policy = surface_mesh_gates(rig, candidate, rest_field, skeleton, grid.spacing)
     still = [g.name for g in again if not g.passed]
-    kept = _no_worse(failed, still)
-    progress(
-        f"{added} edges split toward the field where the normals disagree ({declined} marked triangles "
-        f"declined: a midpoint there would not reach the zero set): mesh gates "
-        f"{len(again) - len(still)}/{len(again)} passed"
+    return _no_worse(failed, still), (candidate, again, again_policy, still)
+
+
+def _verdict(result: Remedy, kept: bool) -> str:
+    gates, still = result[1], result[3]
+    return (
+        f"mesh gates {len(gates) - len(still)}/{len(gates)} passed"
         + (f"; failed {still}" if still else "")
         + ("" if kept else " (not kept)")
     )
-    return (split, again, again_policy, still) if kept else (ex, gates, policy, failed)
 
 
 def build_surface(

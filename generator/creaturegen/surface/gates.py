@@ -67,6 +67,9 @@ BOX_SEEDS = 2048
 SEED_OFFSET_FACTOR = 0.02
 BOX_PADDING_FACTOR = 0.1
 NEWTON_STEPS = 8
+#: A projected point within this fraction of the convergence tolerance takes no further Newton step: it can
+#: move the point by no more than a thousandth of what the gates could see.
+SETTLED_FRACTION = 1e-3
 #: Interior barycentric sample points per face besides the centroid (the three (2/3, 1/6, 1/6) points).
 _INTERIOR = np.array([[4.0, 1.0, 1.0], [1.0, 4.0, 1.0], [1.0, 1.0, 4.0], [2.0, 2.0, 2.0]]) / 6.0
 
@@ -156,7 +159,7 @@ def project_to_zero_set(
     fake a failure. ``field`` (distance and gradient in one pass) and ``initial`` (its values at
     ``points``, already known) save evaluations and change no value."""
     fused = field if field is not None else _fused(distance, gradient)
-    p, d, g = newton_project(fused, points, steps, initial)
+    p, d, g = newton_project(fused, points, steps, initial, settled=SETTLED_FRACTION * tol)
     return p, np.abs(d) < tol, g
 
 

@@ -16,7 +16,9 @@ vertices do not move. The mesh gates judge the result as they judged the lattice
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable
+from dataclasses import dataclass
 
 import numpy as np
 import numpy.typing as npt
@@ -40,7 +42,6 @@ LEVELS = 8
 #: midpoint counts as arrived within PROJECT_TOL of the edge's length of the zero set.
 NEWTON_STEPS = 6
 PROJECT_TOL = 1e-3
-MAX_MOVE = 0.5
 #: Below this |∇d · direction| the line runs along the surface: no Newton step is taken.
 SLOPE_FLOOR = 0.1
 #: Closures taken again without the marked faces around midpoints that did not arrive, before the round
@@ -50,6 +51,11 @@ RETRIES = 12
 #: points nowhere useful. A blend crease that the lattice cuts across can turn 120-125° within one edge
 #: (seed 81's leg joint at hero); its bisector is still the way to the fillet, so the bound sits past that.
 OPPOSED_COS = -0.866
+#: How far a midpoint may travel along its line, in edge lengths: the depth below the chord of a V whose
+#: sides' normals are OPPOSED_COS apart, (l/2)·tan(θ/2) for the angle θ between them (1.87 l at 150°).
+#: A tighter clamp stopped midpoints short of the fillet on exactly the creases the bound above admits:
+#: seed 88's hips at hero, normals 130° apart, fillet 0.55 l below the chord (refused with 0.5 l).
+MAX_MOVE = 0.5 * math.sqrt((1.0 - OPPOSED_COS) / (1.0 + OPPOSED_COS))
 
 
 def normal_departures(mesh: Mesh, gradient: Callable[[F64], F64]) -> tuple[F64, F64]:
@@ -91,10 +97,10 @@ def _close_marks(keys: I64, longest: I64, marked: I64) -> npt.NDArray[np.bool_]:
         marked = np.union1d(marked, keys[missing, longest[missing]])
 
 
-def _midpoints(start: F64, end: F64, field: FieldFn) -> tuple[F64, npt.NDArray[np.bool_]]:
+def _midpoints(start: F64, end: F64, field: FieldFn) -> tuple[F64, npt.NDArray[np.bool_], F64]:
     """Each edge's midpoint moved onto the zero set along the mean of its ends' unit normals (Newton on
     the distance along that line), and whether it arrived (not where the ends face apart: the mean of
-    two opposed normals points nowhere). Moving along the ends' normals, not along ∇d
+    two opposed normals points nowhere), and ∇d there. Moving along the ends' normals, not along ∇d
     at the midpoint, keeps the point over its own chord: inside a concave fillet ∇d points at one of the
     two sheets, and following it would slide the point sideways and fold its triangles."""
     chord = 0.5 * (start + end)
@@ -108,44 +114,83 @@ def _midpoints(start: F64, end: F64, field: FieldFn) -> tuple[F64, npt.NDArray[n
         step = np.where(np.abs(slope) > SLOPE_FLOOR, d / np.where(slope == 0.0, 1.0, slope), 0.0)
         t = np.clip(t - step, -MAX_MOVE * length, MAX_MOVE * length)
     moved = chord + t[:, None] * direction
-    d, _ = field(moved)
+    d, g = field(moved)
     ok = (np.abs(d) <= PROJECT_TOL * length) & (np.einsum("ij,ij->i", ends[0], ends[1]) > OPPOSED_COS)
-    return moved, ok
+    return moved, ok, g
+
+
+@dataclass(frozen=True)
+class _Split:
+    """One round of splits, with what the next round can reuse: the faces carried over whole come first
+    in the new face list, and ∇d at the new vertices is known from their projection."""
+
+    mesh: Mesh
+    added: int
+    declined: int
+    whole: npt.NDArray[np.bool_]  # (F,) old faces carried over unchanged
+    gradient: F64  # (added, 3) ∇d at the new vertices
+    fresh_gradient: F64  # ∇d at the centroids of the new faces (after the whole ones)
 
 
 def split_faces(mesh: Mesh, marked_faces: I64, field: FieldFn) -> tuple[Mesh, int, int]:
     """The mesh with the longest edge of every face in ``marked_faces`` split at its zero-set midpoint,
     closed by longest-edge refinement (no T-junction is left); returns (mesh, vertices added, marked
     faces declined). A midpoint that cannot reach the zero set (an edge across a crease or a thin tip)
-    is never left on its chord, where it would stand off the surface as a spike: the marked faces
-    around it are declined and the closure is taken again without them."""
+    is never left on its chord, where it would stand off the surface as a spike, nor kept where a
+    triangle around it would face against ∇d: the marked faces around it are declined and the closure
+    is taken again without them."""
+    done = _split(mesh, marked_faces, field)
+    return done.mesh, done.added, done.declined
+
+
+def _split(mesh: Mesh, marked_faces: I64, field: FieldFn) -> _Split:
     faces = mesh.faces.astype(np.int64)
     vertices = mesh.vertices
     count = vertices.shape[0]
     keys = _edge_keys(faces, count)
     longest = _longest(vertices, faces, keys)
-    rows = np.arange(faces.shape[0])
     marked = np.unique(marked_faces)
     stuck = np.zeros(count, dtype=bool)
+    unchanged = _Split(
+        mesh, 0, int(marked.size), np.ones(faces.shape[0], dtype=bool), np.zeros((0, 3)), np.zeros((0, 3))
+    )
     for _ in range(RETRIES):
         split = _close_marks(keys, longest, np.unique(keys[marked, longest[marked]]))
         edges = np.unique(keys[split])
         if edges.size == 0:
-            return mesh, 0, int(np.unique(marked_faces).size)
-        mids, ok = _midpoints(vertices[edges // count], vertices[edges % count], field)
+            return unchanged
+        mids, ok, at_mids = _midpoints(vertices[edges // count], vertices[edges % count], field)
         if ok.all():
-            break
+            new_faces, whole = _assemble(faces, keys, longest, split, edges, count)
+            fresh = new_faces[np.count_nonzero(whole) :]
+            refined = np.concatenate([vertices, mids])
+            corners = refined[fresh]
+            at_fresh = field(corners.mean(axis=1))[1]
+            normal = np.cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0])
+            folded = np.einsum("ij,ij->i", normal, at_fresh) <= 0.0
+            if not folded.any():
+                mesh_out = Mesh(refined, new_faces.astype(mesh.faces.dtype))
+                declined = int(np.unique(marked_faces).size - marked.size)
+                return _Split(mesh_out, int(edges.size), declined, whole, at_mids, at_fresh)
+            # A midpoint carried into a narrow crease can fold the triangles around it: decline its edge.
+            folding = np.unique(fresh[folded][fresh[folded] >= count]) - count
+            ok[folding] = False
         # Decline the marked faces around the stuck ends, one ring wider on every retry: a closure can
         # reach a stuck edge from a marked face a few triangles away (along its longest-edge path).
         stuck[edges[~ok] // count] = True
         stuck[edges[~ok] % count] = True
         stuck[faces[stuck[faces].any(axis=1)].ravel()] = True
         marked = marked[~stuck[faces[marked]].any(axis=1)]
-    else:
-        return mesh, 0, int(np.unique(marked_faces).size)
-    declined = int(np.unique(marked_faces).size - marked.size)
-    mid = np.where(split, count + np.searchsorted(edges, keys), -1)  # (F, 3) midpoint of edge k, or -1
+    return unchanged
 
+
+def _assemble(
+    faces: I64, keys: I64, longest: I64, split: npt.NDArray[np.bool_], edges: I64, count: int
+) -> tuple[I64, npt.NDArray[np.bool_]]:
+    """The new face list (faces kept whole first) and which old faces were kept whole, for the split
+    flags of a closed marking; the midpoint of ``edges[i]`` is vertex ``count + i``."""
+    rows = np.arange(faces.shape[0])
+    mid = np.where(split, count + np.searchsorted(edges, keys), -1)  # (F, 3) midpoint of edge k, or -1
     # Rotate every face so its longest edge comes first: (a, b) longest, c opposite, m its midpoint;
     # p splits (b, c) and q splits (c, a) where those are split too.
     turn = (longest[:, None] + np.arange(3)) % 3
@@ -161,29 +206,31 @@ def split_faces(mesh: Mesh, marked_faces: I64, field: FieldFn) -> tuple[Mesh, in
     out += [np.stack((a, mab, q), axis=1)[two], np.stack((mab, c, q), axis=1)[two]]
     two = s[:, 0] & s[:, 1]
     out += [np.stack((mab, b, p), axis=1)[two], np.stack((mab, p, c), axis=1)[two]]
-    new_faces = np.concatenate(out).astype(mesh.faces.dtype)
-    return Mesh(np.concatenate([vertices, mids]), new_faces), int(edges.size), declined
+    return np.concatenate(out), whole
 
 
 def subdivide_to_field(mesh: Mesh, field: FieldFn, levels: int = LEVELS) -> tuple[Mesh, int, int]:
     """Up to ``levels`` rounds of ``split_faces`` on the faces whose normal, or a corner's, departs from
-    the field past the marking angles; returns (mesh, vertices added, marked faces declined)."""
+    the field past the marking angles; returns (mesh, vertices added, marked faces declined). Vertices
+    never move and whole faces keep their centroids, so ∇d is evaluated only at what a round made new."""
     added = declined = 0
-
-    def gradient(p: F64) -> F64:
-        return field(p)[1]
-
+    at_vertices = field(mesh.vertices)[1]
+    at_centroids = field(mesh.corners().mean(axis=1))[1]
     for _ in range(levels):
-        vertex, face = normal_departures(mesh, gradient)
+        vertex = angles_deg(vertex_normals(mesh), at_vertices)
+        face = angles_deg(mesh.face_normals(), at_centroids)
         bad_vertex = vertex > MARK_VERTEX_DEG
         marked = np.flatnonzero((face > MARK_FACE_DEG) | bad_vertex[mesh.faces].any(axis=1))
         if marked.size == 0:
             break
-        mesh, more, off = split_faces(mesh, marked, field)
-        added += more
-        declined += off
-        if more == 0:
+        done = _split(mesh, marked, field)
+        added += done.added
+        declined += done.declined
+        if done.added == 0:
             break
+        mesh = done.mesh
+        at_vertices = np.concatenate([at_vertices, done.gradient])
+        at_centroids = np.concatenate([at_centroids[done.whole], done.fresh_gradient])
     return mesh, added, declined
 
 

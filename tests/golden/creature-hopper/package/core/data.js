@@ -2844,7 +2844,7 @@ export const CREATURE = Object.freeze({
     0
   ],
   "signatures": {
-    "compilerSignature": "60b24a9423ad9891c4c2fa1a0323000dce915ce91f241b4c34c56d50d3b43df3",
+    "compilerSignature": "186a65a64d4df07591527d374c15ef17bed73f243b805ad32521c115a7c7ffb8",
     "geometryDigest": "400b0d18a2a9f6bbbfe5b441f89767f552a4f3b4c45a368d1129d632e1d2f4f1",
     "topologySignature": "330d551e8c006f84b01459c84db69ca8c43aec5bc9d9083d3e85c291be5a68bf"
   },
