@@ -52,6 +52,7 @@ help:
 	@echo "make golden   rebuild tests/golden/ (the byte-for-byte package records); review and commit the diff"
 	@echo "make lab      serve $(WEB_LAB)/ at http://$(LAB_HOST):$(LAB_PORT)/"
 	@echo "make bench    bench/results/field.json (candidates, analytic vs FD), frost.json (tiers, tiles, idle),"
+	@echo "              frost_strokes.json (1, 8, 64 strokes at once: binned vs unbinned update, p50/p95),"
 	@echo "              surface.json (narrow band vs dense, numpy vs wgpu, extraction, gates),"
 	@echo "              runtime.json (creature frame p50/p95 vs bodies, per-body cost, baseline vs 7P/K, spawns),"
 	@echo "              motion.json (locomotion core in Node: µs per creature per step, rope cost, allocation),"
@@ -121,6 +122,8 @@ bench: setup
 	$(VENV_PY) bench/field.py --out bench/results/field.json
 	@echo "==> frost benchmark (WebGPU on SwiftShader) into bench/results/frost.json"
 	$(VENV_PY) bench/frost.py --out bench/results/frost.json
+	@echo "==> frost strokes benchmark (1, 8, 64 strokes at once, binned vs unbinned) into bench/results/frost_strokes.json"
+	$(VENV_PY) bench/frost_strokes.py --out bench/results/frost_strokes.json
 	@echo "==> surface benchmark (narrow band vs dense, numpy vs wgpu, extraction, gates) into bench/results/surface.json"
 	$(VENV_PY) bench/surface.py --out bench/results/surface.json
 	@echo "==> runtime benchmark (creature population on WebGPU/SwiftShader, shipped vs forbidden baseline) into bench/results/runtime.json"

@@ -8,6 +8,7 @@ Node and the lab's three are required (the tests fail, never skip, without them)
 from __future__ import annotations
 
 import base64
+import dataclasses
 import hashlib
 import json
 import re
@@ -21,10 +22,12 @@ import pytest
 
 from conftest import EXAMPLES, run_cli
 from creaturegen.frost.brush import Segment
+from creaturegen.frost.params import params_from_plan
+from creaturegen.frost.schedule import bin_steps
 from creaturegen.frost.structure import generate_structure
-from creaturegen.frost.timeline import late_steps
+from creaturegen.frost.timeline import chunk_steps, late_steps, split_interval
 from creaturegen.lab.browser import launch_lab_page
-from creaturegen.lab.frost_parity import shipped_structure
+from creaturegen.lab.frost_parity import shipped_structure, strokes_at_once
 from creaturegen.lab.server import WEB_LAB, serve
 from creaturegen.resources import lab_modules
 from creaturegen.spec.frost import Structure
@@ -400,7 +403,7 @@ const segs = raw.map(([t0, t1, start, end]) =>
   normalizeSegment({{ t0, t1, start, end, pressure0: 0.5, pressure1: 0.9 }}));
 const out = [];
 for (const [previous, origin, from] of [[0.5, 0.0, 0], [0.5, 0.2, 0], [0.5, 0.0, 1], [0.9, 0.6, 0]]) {{
-  out.push(lateSteps(previous, segs, origin, from).map((s) => [segs.indexOf(s.segment), s.dt, s.age]));
+  out.push(lateSteps(previous, segs, origin, from).map((s) => [segs.indexOf(s.segments[0]), s.dt, s.age]));
 }}
 console.log(JSON.stringify(out));
 """
@@ -410,7 +413,53 @@ console.log(JSON.stringify(out));
     cases = [(0.5, 0.0, 0), (0.5, 0.2, 0), (0.5, 0.0, 1), (0.9, 0.6, 0)]
     for (previous, origin, start), js in zip(cases, got, strict=True):
         expected = [
-            [segments.index(s.segment), s.dt, s.age]  # type: ignore[arg-type]
+            [segments.index(s.segments[0]), s.dt, s.age]
             for s in late_steps(previous, segments[start:], origin)
         ]
         assert js == expected, (previous, origin, start)
+
+
+def test_js_bins_chunks_and_steps_are_numpy_s_for_several_strokes(packages: dict[str, Path]) -> None:
+    """Several streams at once: the JS core's splitInterval (every active segment per step), chunkSteps
+    (by steps and pairs) and StepBins (entries per screen tile, CSR) against numpy's, on crossing strokes
+    of a frost parity job; every bin's entry list must hold its pairs in step order."""
+    segments = strokes_at_once(6)
+    params = params_from_plan(json.loads((packages["budgeted"] / "build-report.json").read_text())["params"])
+    width, height = 160, 96
+    core = packages["budgeted"] / "core" / "frost-core.js"
+    plan = packages["budgeted"] / "core" / "plan.js"
+    script = f"""
+const {{ splitInterval, chunkSteps, StepBins, normalizeSegment }} = await import({json.dumps(core.as_uri())});
+const {{ PLAN }} = await import({json.dumps(plan.as_uri())});
+const segs = {json.dumps([dataclasses.asdict(g) for g in segments])}.map(normalizeSegment);
+const steps = splitInterval(0.05, 0.3, segs);
+const chunks = chunkSteps(steps, PLAN.params.maxSteps, 7);
+const bins = new StepBins(PLAN.params);
+const out = {{ steps: steps.map((s) => [s.dt, s.segments.map((g) => segs.indexOf(g))]), chunks: [] }};
+for (const chunk of chunks) {{
+  bins.bin(chunk, {width}, {height});
+  const perBin = [];
+  let ordered = true;
+  for (let b = 0; b < bins.count; b++) {{
+    perBin.push(bins.start[b + 1] - bins.start[b]);
+    for (let e = bins.start[b] + 1; e < bins.start[b + 1]; e++) {{
+      ordered &&= bins.entries[e] > bins.entries[e - 1];
+    }}
+  }}
+  out.chunks.push({{ size: chunk.length, perBin, ordered, single: bins.single }});
+}}
+console.log(JSON.stringify(out));
+"""
+    done = run_node(script, packages["budgeted"])
+    assert done.returncode == 0, done.stderr
+    got = json.loads(done.stdout)
+    steps = split_interval(0.05, 0.3, segments)
+    assert [[s.dt, [segments.index(g) for g in s.segments]] for s in steps] == got["steps"]
+    assert max(len(s.segments) for s in steps) >= 4  # the strokes do overlap in time
+    chunks = chunk_steps(steps, params.max_steps, 7)
+    assert [len(c) for c in chunks] == [c["size"] for c in got["chunks"]]
+    for chunk, js in zip(chunks, got["chunks"], strict=True):
+        bins = bin_steps(chunk, params, width, height)
+        assert js["perBin"] == bins.entries.tolist()
+        assert js["ordered"]
+        assert js["single"] is False

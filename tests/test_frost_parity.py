@@ -206,3 +206,54 @@ def test_parity_job_holds_a_float32_history_to_its_own_tolerance(
     failed = {g["name"]: g["value"] for g in result.gates if g["status"] == "fail"}
     assert any(name.startswith("GPU vs numpy history") for name in failed), result.summary()
     assert all(value < 2.0**-11 for value in failed.values()), result.summary()
+
+
+@pytest.mark.browser
+@pytest.mark.parametrize(
+    ("planted_defect", "target_file", "swap", "gate"),
+    [
+        (
+            "a kernel that keeps the last stroke's coverage instead of the largest",
+            "tsl/frost-effect.js",
+            ("br.assign(max(br, info.x", "br.assign(max(float(0), info.x"),
+            "GPU vs numpy history, 8 strokes at once",
+        ),
+        (
+            "bins that leave out the last bin column a capsule reaches",
+            "core/frost-core.js",
+            (
+                "bx <= Math.floor(box[2] / size); bx++",
+                "bx < Math.floor(box[2] / size); bx++",
+            ),
+            "frames whose bin entries or law evaluations differ from numpy's",
+        ),
+        (
+            "a kernel that forgets the decay of the steps its bin skips",
+            "tsl/frost-effect.js",
+            ("xr.mulAssign(exp(float(-vis.decay).mul(s.z.sub(elapsed))));", ""),
+            "GPU vs numpy history, 8 strokes at once",
+        ),
+    ],
+)
+def test_parity_job_catches_a_wrong_binned_update(
+    built: dict[str, Path],
+    tmp_path: Path,
+    planted_defect: str,
+    target_file: str,
+    swap: tuple[str, str],
+    gate: str,
+) -> None:
+    # Several strokes at once run through the bins: a texel must take the largest coverage among its
+    # bin's pairs, every pair whose capsule reaches a bin must be in it, and a step with no pair in the
+    # bin must still decay the texel. frost-full: a full-resolution history in 16-texel bins (the
+    # budgeted one has two bins, which every stroke reaches in every step).
+    source = built["frost-full"]
+    broken = tmp_path / source.name
+    shutil.copytree(source, broken)
+    target = broken / target_file
+    text = target.read_text()
+    assert swap[0] in text, planted_defect
+    target.write_text(text.replace(swap[0], swap[1]))  # every occurrence: StepBins counts, then fills
+    result = run_frost_parity(broken, groups=("history",))
+    failed = [g["name"] for g in result.gates if g["status"] == "fail"]
+    assert any(name.startswith(gate) for name in failed), f"{planted_defect}: {result.summary()}"

@@ -47,6 +47,7 @@ def segment_of(data: dict[str, Any]) -> Segment:
         end=(data["end"][0], data["end"][1]),
         pressure0=data["pressure0"],
         pressure1=data["pressure1"],
+        stream=data.get("stream", 0),
     )
 
 

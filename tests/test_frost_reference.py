@@ -23,7 +23,7 @@ from creaturegen.frost.formats import (
 )
 from creaturegen.frost.params import DIFFUSION_STABILITY, FrostParams, frost_params
 from creaturegen.frost.reference import STATE_CHANNELS, FrostReference, remap_bilinear
-from creaturegen.frost.schedule import TileScheduler, diffusion_substeps
+from creaturegen.frost.schedule import TileScheduler, bin_steps, diffusion_substeps, texel_box
 from creaturegen.frost.timeline import (
     Step,
     chunk_steps,
@@ -224,16 +224,16 @@ def test_split_interval_cuts_at_segment_boundaries() -> None:
     b = Segment(0.25, 0.3, (0.2, 0.1), (0.3, 0.1))
     c = Segment(0.3, 0.5, (0.3, 0.1), (0.4, 0.1))
     steps = split_interval(0.15, 0.4, [a, b, c])
-    assert [s.segment for s in steps] == [a, None, b, c]
+    assert [s.segments for s in steps] == [(a,), (), (b,), (c,)]
     assert [s.dt for s in steps] == pytest.approx([0.05, 0.05, 0.05, 0.1], abs=1e-15)
     assert math.fsum(s.dt for s in steps) == pytest.approx(0.4 - 0.15, abs=1e-15)
     # an interval inside one segment is a single step of that segment
     inner = split_interval(0.35, 0.45, [a, b, c])
     assert len(inner) == 1
-    assert inner[0].segment == c
+    assert inner[0].segments == (c,)
     assert inner[0].dt == pytest.approx(0.1, abs=1e-15)
     # no segments at all: pure decay
-    assert split_interval(0.0, 0.5, []) == [Step(0.5, None)]
+    assert split_interval(0.0, 0.5, []) == [Step(0.5)]
 
 
 def test_split_interval_conformance_path_sums_exactly() -> None:
@@ -250,21 +250,39 @@ def test_split_interval_conformance_path_sums_exactly() -> None:
                 covering = [g for g in segments if g.t0 <= middle < g.t1]
                 if step.dt < 1e-12:
                     pass  # a sliver between a frame instant and a boundary one ulp away: either side is right
-                elif step.segment is None:
+                elif not step.segments:
                     assert not covering, (fps, start)
                 else:
-                    assert covering == [step.segment], (fps, start)
-                    assert step.segment.t0 <= start + 1e-12
-                    assert end <= step.segment.t1 + 1e-12
+                    assert covering == list(step.segments), (fps, start)
+                    assert step.segments[0].t0 <= start + 1e-12
+                    assert end <= step.segments[0].t1 + 1e-12
                 start = end
 
 
 def test_chunk_steps_sizes() -> None:
-    steps = [Step(0.01, None)] * 35
-    assert [len(c) for c in chunk_steps(steps, 16)] == [16, 16, 3]
-    assert [len(c) for c in chunk_steps(steps[:16], 16)] == [16]
-    assert chunk_steps([], 16) == []
-    assert [s for chunk in chunk_steps(steps, 7) for s in chunk] == steps
+    steps = [Step(0.01)] * 35
+    assert [len(c) for c in chunk_steps(steps, 16, 256)] == [16, 16, 3]
+    assert [len(c) for c in chunk_steps(steps[:16], 16, 256)] == [16]
+    assert chunk_steps([], 16, 256) == []
+    assert [s for chunk in chunk_steps(steps, 7, 256) for s in chunk] == steps
+
+
+def test_chunk_steps_end_before_too_many_pairs() -> None:
+    """Several strokes at once put several segments in a step: a chunk also ends at ``max_pairs``."""
+    g = Segment(0.0, 1.0, (0.1, 0.1), (0.2, 0.1))
+    steps = [Step(0.01, (g,) * 5)] * 7
+    assert [len(c) for c in chunk_steps(steps, 16, 12)] == [2, 2, 2, 1]
+    assert [len(c) for c in chunk_steps(steps, 16, 5)] == [1] * 7
+    assert [s for chunk in chunk_steps(steps, 16, 12) for s in chunk] == steps
+
+
+def test_split_interval_keeps_every_stream_active() -> None:
+    """Two pointers at once: each piece holds every segment active throughout it."""
+    a = Segment(0.0, 0.3, (0.1, 0.1), (0.2, 0.1), stream=1)
+    b = Segment(0.1, 0.4, (0.5, 0.5), (0.6, 0.5), stream=2)
+    steps = split_interval(0.0, 0.5, [a, b])
+    assert [s.segments for s in steps] == [(a,), (a, b), (b,), ()]
+    assert sum(s.pointer_seconds for s in steps) == pytest.approx(0.6)
 
 
 def test_validate_segment() -> None:
@@ -288,12 +306,12 @@ def test_full_field_idles_after_convergence() -> None:
     assert params.idle_when_converged
     scheduler = TileScheduler(params, 48, 32)
     stroke = Segment(0.0, 0.1, (0.3, 0.5), (0.6, 0.5))
-    first = scheduler.plan([Step(0.1, stroke)], 0.1, 0)
+    first = scheduler.plan([Step(0.1, (stroke,))], 0.1, 0)
     assert first.update == (0,)
     assert first.retire == ()
     updates, retires = [], []
     for _ in range(200):
-        plan = scheduler.plan([Step(1.0, None)], 1.0, 0)
+        plan = scheduler.plan([Step(1.0)], 1.0, 0)
         updates.append(plan.update)
         retires.append(plan.retire)
     retired_at = [k for k, r in enumerate(retires) if r]
@@ -306,7 +324,7 @@ def test_full_field_idles_after_convergence() -> None:
     assert all(u == (0,) for u in updates[:k])
     assert all(u == () for u in updates[k:])
     # a brush wakes it again
-    assert scheduler.plan([Step(0.1, stroke)], 0.1, 0).update == (0,)
+    assert scheduler.plan([Step(0.1, (stroke,))], 0.1, 0).update == (0,)
 
 
 def test_full_field_reference_idles_with_zero_dispatches() -> None:
@@ -330,7 +348,7 @@ def test_full_field_without_idle_updates_every_frame() -> None:
     params = dataclasses.replace(params_of("frost-full"), idle_when_converged=False)
     scheduler = TileScheduler(params, 48, 32)
     for _ in range(150):
-        plan = scheduler.plan([Step(1.0, None)], 1.0, 0)
+        plan = scheduler.plan([Step(1.0)], 1.0, 0)
         assert plan.update == (0,)
         assert plan.retire == ()
 
@@ -342,7 +360,7 @@ def test_dirty_tiles_update_only_near_the_stroke() -> None:
     scheduler = TileScheduler(params, width, height)
     assert (scheduler.tiles_x, scheduler.tiles_y) == (8, 4)
     stroke = Segment(0.0, 0.05, (0.1, 0.2), (0.15, 0.2))
-    plan = scheduler.plan([Step(0.05, stroke)], 0.05, 0)
+    plan = scheduler.plan([Step(0.05, (stroke,))], 0.05, 0)
     assert plan.update
     assert len(plan.update) < 8 * 4 // 2
     mask = plan.mask(plan.update, width, height)
@@ -366,10 +384,10 @@ def test_dirty_tiles_retire_once_per_tile() -> None:
     ]
     touched: set[int] = set()
     for segment in segments:
-        touched.update(scheduler.plan([Step(0.05, segment)], 0.05, 0).update)
+        touched.update(scheduler.plan([Step(0.05, (segment,))], 0.05, 0).update)
     retired: list[int] = []
     for _ in range(40):
-        plan = scheduler.plan([Step(1.0, None)], 1.0, 0)
+        plan = scheduler.plan([Step(1.0)], 1.0, 0)
         assert not set(plan.retire) & set(plan.update)
         retired.extend(plan.retire)
     assert sorted(retired) == sorted(touched)
@@ -661,7 +679,7 @@ def test_late_steps_clip_to_the_origin_and_to_previous() -> None:
     early = Segment(t0=0.1, t1=0.3, start=(0.2, 0.5), end=(0.4, 0.5))
     spanning = Segment(t0=0.3, t1=0.6, start=(0.4, 0.5), end=(0.6, 0.5))
     steps = late_steps(0.5, [early, spanning], origin=0.2)
-    assert [(s.segment, s.dt, s.age) for s in steps] == [
+    assert [(s.segments[0], s.dt, s.age) for s in steps] == [
         (early, pytest.approx(0.1), pytest.approx(0.2)),
         (spanning, pytest.approx(0.2), 0.0),
     ]
@@ -677,3 +695,101 @@ def test_segments_from_before_a_discontinuity_deposit_nothing() -> None:
     reference.update(5.0, 5.1)
     assert float(np.abs(reference.state).max()) == 0.0
     assert reference.counters.pointer_seconds == 0.0
+
+
+# ---------------------------------------------------------------------------------- several strokes at once
+
+
+def _strokes(stream: int, v: float, t0: float = 0.0) -> list[Segment]:
+    """A 0.6 s left-to-right wipe at height v in six segments of one stream."""
+    return [
+        Segment(t0 + 0.1 * k, t0 + 0.1 * (k + 1), (0.2 + 0.1 * k, v), (0.3 + 0.1 * k, v), stream=stream)
+        for k in range(6)
+    ]
+
+
+def _replay(params: FrostParams, segments: list[Segment], fps: int = 30) -> FrostReference:
+    reference = FrostReference(params, *GRID)
+    for segment in sorted(segments, key=lambda g: (g.t0, g.stream)):
+        reference.queue(segment)
+    instants = [k / fps for k in range(round(0.8 * fps) + 1)]
+    for previous, current in itertools.pairwise(instants):
+        reference.update(previous, current)
+    return reference
+
+
+def test_two_strokes_at_once_each_leave_their_own_trail() -> None:
+    """Two pointers wiping at the same time, far apart: each half of the pane holds exactly what that
+    stroke alone leaves (the step holds both segments and a texel takes the larger coverage, which is
+    the only one there); pointer time counts both streams."""
+    params = dataclasses.replace(params_of("frost-budgeted"), diffusivity=0.0)
+    top, bottom = _strokes(1, 0.25), _strokes(2, 0.75)
+    both = _replay(params, top + bottom)
+    alone_top, alone_bottom = _replay(params, top), _replay(params, bottom)
+    half = GRID[1] // 2
+    assert np.array_equal(both.state[:half], alone_top.state[:half])
+    assert np.array_equal(both.state[half:], alone_bottom.state[half:])
+    assert float(both.state[..., 0].max()) > 0.1
+    assert both.counters.pointer_seconds == pytest.approx(1.2, abs=1e-12)
+
+
+def test_two_streams_on_one_path_equal_one_stream() -> None:
+    """max(b, b) = b: a second pointer retracing the first at the same instants adds nothing."""
+    params = dataclasses.replace(params_of("frost-budgeted"), diffusivity=0.0)
+    twice = _replay(params, _strokes(1, 0.5) + _strokes(2, 0.5))
+    once = _replay(params, _strokes(1, 0.5))
+    assert np.array_equal(twice.state, once.state)
+
+
+def test_a_stream_may_not_overlap_itself_and_streams_are_capped() -> None:
+    params = dataclasses.replace(params_of("frost-budgeted"), max_streams=3)
+    reference = FrostReference(params, *GRID)
+    reference.queue(Segment(0.0, 0.2, (0.1, 0.1), (0.2, 0.1), stream=1))
+    with pytest.raises(ValueError, match="before the previous one ended"):
+        reference.queue(Segment(0.1, 0.3, (0.1, 0.1), (0.2, 0.1), stream=1))
+    reference.queue(Segment(0.1, 0.3, (0.1, 0.1), (0.2, 0.1), stream=2))
+    reference.queue(Segment(0.1, 0.3, (0.1, 0.1), (0.2, 0.1), stream=3))
+    with pytest.raises(ValueError, match="would overlap 3 other streams"):
+        reference.queue(Segment(0.15, 0.3, (0.1, 0.1), (0.2, 0.1), stream=4))
+    reference.queue(Segment(0.3, 0.4, (0.1, 0.1), (0.2, 0.1), stream=4))  # after the others: fine
+
+
+def test_bins_count_every_pair_whose_box_reaches_them() -> None:
+    """Entries per bin against a brute-force count over texel boxes, and the overflow rule: a chunk past
+    the bin capacity is one bin with every pair (the unbinned cost), never a truncated list."""
+    params = params_of("frost-budgeted")
+    w, h = GRID
+    rng = np.random.default_rng(7)
+    steps = []
+    for _ in range(5):
+        segments = []
+        for stream in range(4):
+            a, b = rng.uniform(0, 1, 2), rng.uniform(0, 1, 2)
+            segments.append(
+                Segment(0.0, 1.0, (float(a[0]), float(a[1])), (float(b[0]), float(b[1])), stream=stream)
+            )
+        steps.append(Step(0.01, tuple(segments)))
+    bins = bin_steps(steps, params, w, h)
+    size = params.tile_size
+    expected = np.zeros(bins.entries.shape, dtype=np.int64)
+    for step in steps:
+        for segment in step.segments:
+            box = texel_box(segment, step.dt, params.brush_reach, w, h)
+            assert box is not None
+            for b in range(expected.size):
+                by, bx = divmod(b, bins.bins_x)
+                if (
+                    bx * size <= box[2]
+                    and box[0] < (bx + 1) * size
+                    and by * size <= box[3]
+                    and box[1] < (by + 1) * size
+                ):
+                    expected[b] += 1
+    assert not bins.single
+    assert np.array_equal(bins.entries, expected)
+    update = np.ones((h, w), dtype=bool)
+    assert bins.texel_steps(update) < update.sum() * 20  # binning skips what an unbinned loop evaluates
+    small = bin_steps(steps, dataclasses.replace(params, bin_capacity=int(expected.sum()) - 1), w, h)
+    assert small.single
+    assert small.total == 20
+    assert small.texel_steps(update) == update.sum() * 20

@@ -27,7 +27,12 @@ NOISE_SALT = (0x68E31DA4, 0xB5297A4D)
 
 @dataclass(frozen=True)
 class Segment:
-    """One pointer move between two timestamped samples; positions in history UV, pressures in [0, 1]."""
+    """One pointer move between two timestamped samples; positions in history UV, pressures in [0, 1].
+
+    ``stream`` names the pointer it came from (a finger, a pen, a mouse: attachPointer uses the pointerId):
+    segments of one stream are time-ordered and disjoint, segments of different streams may overlap in
+    time (several strokes at once), and a texel under several of them at once takes the largest coverage.
+    """
 
     t0: float
     t1: float
@@ -35,6 +40,7 @@ class Segment:
     end: tuple[float, float]
     pressure0: float = 1.0
     pressure1: float = 1.0
+    stream: int = 0
 
     @property
     def pressure(self) -> float:

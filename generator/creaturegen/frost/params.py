@@ -16,6 +16,14 @@ from ..spec.frost import FrostEffectSpec, HistoryChannel
 #: Sub-steps (piecewise-constant input intervals) one update dispatch applies; more are chunked into
 #: several dispatches. The reference chunks identically because every dispatch ends in a storage write.
 MAX_STEPS_PER_DISPATCH = 16
+#: (step, segment) pairs one update dispatch holds (several strokes at once put several segments in a
+#: step); a chunk ends before it would hold more. Both sides chunk by this rule.
+MAX_PAIRS_PER_DISPATCH = 256
+#: Pointer streams that may deposit at once (pointer() refuses a segment that would make more overlap).
+MAX_STREAMS = 64
+#: Bin entries one dispatch holds: a chunk whose binned entries would exceed it is dispatched as one bin
+#: (every texel loops over every pair, the unbinned cost), never truncated.
+BIN_CAPACITY = 1 << 20
 
 #: Explicit 5-point diffusion is stable for D·dt/dx² ≤ 1/4 in 2-D; larger frames take more substeps.
 DIFFUSION_STABILITY = 0.25
@@ -62,6 +70,9 @@ class FrostParams:
     discontinuity: Literal["reset", "freeze"]
     resize_policy: Literal["clear", "preserve-remap"]
     max_steps: int = MAX_STEPS_PER_DISPATCH
+    max_pairs: int = MAX_PAIRS_PER_DISPATCH
+    max_streams: int = MAX_STREAMS
+    bin_capacity: int = BIN_CAPACITY
 
     @property
     def channels(self) -> tuple[ChannelRates, ChannelRates]:
@@ -91,6 +102,9 @@ class FrostParams:
             "discontinuity": self.discontinuity,
             "resizePolicy": self.resize_policy,
             "maxSteps": self.max_steps,
+            "maxPairs": self.max_pairs,
+            "maxStreams": self.max_streams,
+            "binCapacity": self.bin_capacity,
             "diffusionStability": DIFFUSION_STABILITY,
             "workgroup2d": list(WORKGROUP_2D),
             "workgroupLinear": WORKGROUP_LINEAR,
@@ -114,6 +128,9 @@ def params_from_plan(plan: dict[str, Any]) -> FrostParams:
         discontinuity=plan["discontinuity"],
         resize_policy=plan["resizePolicy"],
         max_steps=plan["maxSteps"],
+        max_pairs=plan["maxPairs"],
+        max_streams=plan["maxStreams"],
+        bin_capacity=plan["binCapacity"],
     )
 
 

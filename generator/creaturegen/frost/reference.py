@@ -20,7 +20,7 @@ import numpy as np
 from .brush import Segment, coverage, texel_noise
 from .law import Array, advance, catch_up
 from .params import FrostParams
-from .schedule import BoolGrid, TilePlan, TileScheduler, diffusion_substeps
+from .schedule import BoolGrid, TilePlan, TileScheduler, bin_steps, diffusion_substeps
 from .timeline import (
     Decision,
     Step,
@@ -28,6 +28,7 @@ from .timeline import (
     classify_interval,
     late_steps,
     split_interval,
+    too_many_streams,
     validate_segment,
 )
 
@@ -52,6 +53,9 @@ class FrameReport:
     substeps: int = 0
     late_steps: int = 0
     pointer_seconds: float = 0.0
+    bin_entries: int = 0  # (step, segment) entries over the chunks' bins (schedule.bin_steps)
+    texel_steps: int = 0  # law evaluations: Σ over updated texels of their bin's entries
+    unbinned_texel_steps: int = 0  # what every updated texel looping over every pair would evaluate
 
 
 @dataclass
@@ -74,7 +78,7 @@ class FrostReference:
         self.pending: list[Segment] = []
         self.fresh_from = 0  # pending[fresh_from:] were queued since the last update
         self.origin: float | None = None  # where the history's timeline starts (see late_steps)
-        self._last_end: float | None = None
+        self._last_end: dict[int, float] = {}  # per stream
         self._allocate(width, height)
 
     def _allocate(self, width: int, height: int) -> None:
@@ -92,11 +96,13 @@ class FrostReference:
         return np.asarray(values.astype(self.storage).astype(np.float64))
 
     def queue(self, segment: Segment) -> None:
-        problem = validate_segment(segment, self._last_end)
+        problem = validate_segment(segment, self._last_end.get(segment.stream))
+        if problem is None:
+            problem = too_many_streams(segment, self.pending, self.params.max_streams)
         if problem is not None:
             raise ValueError(problem)
         self.pending.append(segment)
-        self._last_end = segment.t1
+        self._last_end[segment.stream] = segment.t1
 
     def update(self, previous: float, current: float) -> FrameReport:
         decision = classify_interval(previous, current, self.params.max_interval)
@@ -109,7 +115,7 @@ class FrostReference:
             self.pending = []
             self.fresh_from = 0
             self.origin = current
-            self._last_end = None
+            self._last_end = {}
             if self.params.discontinuity == "reset":
                 self._allocate(self.width, self.height)
             self.counters.history.append(report)
@@ -119,7 +125,7 @@ class FrostReference:
         late = late_steps(previous, self.pending[self.fresh_from :], self.origin)
         steps = late + split_interval(previous, current, self.pending)
         report.late_steps = len(late)
-        report.pointer_seconds = sum(s.dt for s in steps if s.segment is not None)
+        report.pointer_seconds = sum(s.pointer_seconds for s in steps)
         substeps = diffusion_substeps(self.params.diffusivity, current - previous, self.height)
         plan = self.scheduler.plan(steps, current - previous, substeps)
         self._apply(plan, steps, substeps, report, current - previous)
@@ -148,8 +154,12 @@ class FrostReference:
             return
         mask = plan.mask(plan.update, w, h)
         texels = plan.texels(plan.update)
-        for chunk_index, chunk in enumerate(chunk_steps(steps, self.params.max_steps)):
+        for chunk_index, chunk in enumerate(chunk_steps(steps, self.params.max_steps, self.params.max_pairs)):
             self._law(chunk, mask, first=chunk_index == 0)
+            bins = bin_steps(chunk, self.params, w, h)
+            report.bin_entries += bins.total
+            report.texel_steps += bins.texel_steps(mask)
+            report.unbinned_texel_steps += int(np.count_nonzero(mask)) * sum(len(s.segments) for s in chunk)
             report.dispatches += 1
             report.texels += texels
         report.substeps = substeps
@@ -165,17 +175,20 @@ class FrostReference:
         deposit = [np.zeros_like(x[0]) if first else self.state[..., c].copy() for c in DEPOSIT_CHANNELS]
         for step in steps:
             for index, channel in enumerate(self.params.channels):
-                if step.segment is None:
-                    b: Array | float = 0.0
-                else:
-                    b = coverage(
-                        step.segment,
-                        self.width,
-                        self.height,
-                        channel.radius,
-                        self.params.softness,
-                        self.thinning[index],
+                b: Array | float = 0.0
+                for segment in step.segments:
+                    b = np.maximum(
+                        b,
+                        coverage(
+                            segment,
+                            self.width,
+                            self.height,
+                            channel.radius,
+                            self.params.softness,
+                            self.thinning[index],
+                        ),
                     )
+                if step.segments:
                     deposit[index] = np.maximum(deposit[index], b)
                 if step.age is None:
                     x[index] = advance(x[index], b, step.dt, channel.decay, channel.fill)

@@ -19,6 +19,7 @@ from dataclasses import dataclass
 import numpy as np
 import numpy.typing as npt
 
+from .brush import Segment
 from .params import DIFFUSION_STABILITY, FrostParams
 from .timeline import Step
 
@@ -56,6 +57,70 @@ class TilePlan:
         return len(tiles) * self.tile_width * self.tile_height
 
 
+def texel_box(
+    segment: Segment, dt: float, reach: float, width: int, height: int
+) -> tuple[int, int, int, int] | None:
+    """Inclusive texel box (x0, y0, x1, y1) a segment's capsule can reach over dt, or None when it deposits
+    nothing (no pressure, no time) or lies off the history."""
+    if segment.pressure <= 0.0 or dt <= 0.0:
+        return None
+    us, vs = (segment.start[0], segment.end[0]), (segment.start[1], segment.end[1])
+    rx = reach * height / width
+    x0 = max(math.floor((min(us) - rx) * width), 0)
+    x1 = min(math.floor((max(us) + rx) * width), width - 1)
+    y0 = max(math.floor((min(vs) - reach) * height), 0)
+    y1 = min(math.floor((max(vs) + reach) * height), height - 1)
+    return None if x0 > x1 or y0 > y1 else (x0, y0, x1, y1)
+
+
+@dataclass(frozen=True)
+class Bins:
+    """The segments of a chunk of steps binned into square screen tiles of ``size`` texels: the GPU loops
+    each texel over its bin's (step, segment) entries only, so overlapping strokes cost Σ_t P_t·E_t (texels
+    of tile t times entries in it) rather than every texel times every pair. A chunk whose entries would
+    overflow the bin capacity is one bin holding every pair (``single``): the unbinned cost, never a loss."""
+
+    size: int
+    bins_x: int
+    entries: npt.NDArray[np.int64]  # (bins,) entries per bin
+    single: bool
+
+    @property
+    def total(self) -> int:
+        return int(self.entries.sum())
+
+    def texel_steps(self, update: BoolGrid) -> int:
+        """Σ over the bins of ``update`` (a texel mask) of texels × entries: the law's evaluations."""
+        if self.single:
+            return int(np.count_nonzero(update)) * self.total
+        count = 0
+        for b in np.flatnonzero(self.entries):
+            by, bx = divmod(int(b), self.bins_x)
+            block = update[by * self.size : (by + 1) * self.size, bx * self.size : (bx + 1) * self.size]
+            count += int(np.count_nonzero(block)) * int(self.entries[b])
+        return count
+
+
+def bin_steps(steps: list[Step], params: FrostParams, width: int, height: int) -> Bins:
+    """Entries per bin of one chunk (the JS core's StepBins, line for line): tiles of the scheduler's
+    tile size, whatever the policy; a pair lands in every bin its capsule's texel box reaches."""
+    size = params.tile_size
+    bins_x, bins_y = math.ceil(width / size), math.ceil(height / size)
+    grid = np.zeros((bins_y, bins_x), dtype=np.int64)
+    pairs = 0
+    for step in steps:
+        for segment in step.segments:
+            pairs += 1
+            box = texel_box(segment, step.dt, params.brush_reach, width, height)
+            if box is None:
+                continue
+            x0, y0, x1, y1 = box
+            grid[y0 // size : y1 // size + 1, x0 // size : x1 // size + 1] += 1
+    if int(grid.sum()) > params.bin_capacity:
+        return Bins(max(width, height), 1, np.array([pairs], dtype=np.int64), True)
+    return Bins(size, bins_x, grid.reshape(-1), False)
+
+
 class TileScheduler:
     """Per-tile channel bounds for one history size; reset by a resize or a discontinuity."""
 
@@ -73,25 +138,16 @@ class TileScheduler:
     def touched(self, steps: list[Step]) -> BoolGrid:
         """Tiles any capsule of this frame can reach (brush AABB in texels, both channels' radii)."""
         touched = np.zeros_like(self.live)
-        reach = self.params.brush_reach
         for step in steps:
-            segment = step.segment
-            if segment is None or segment.pressure <= 0.0 or step.dt <= 0.0:
-                continue
-            us, vs = (segment.start[0], segment.end[0]), (segment.start[1], segment.end[1])
-            rx = reach * self.height / self.width
-            x0 = math.floor((min(us) - rx) * self.width)
-            x1 = math.floor((max(us) + rx) * self.width)
-            y0 = math.floor((min(vs) - reach) * self.height)
-            y1 = math.floor((max(vs) + reach) * self.height)
-            x0, x1 = max(x0, 0), min(x1, self.width - 1)
-            y0, y1 = max(y0, 0), min(y1, self.height - 1)
-            if x0 > x1 or y0 > y1:
-                continue
-            touched[
-                y0 // self.tile_height : y1 // self.tile_height + 1,
-                x0 // self.tile_width : x1 // self.tile_width + 1,
-            ] = True
+            for segment in step.segments:
+                box = texel_box(segment, step.dt, self.params.brush_reach, self.width, self.height)
+                if box is None:
+                    continue
+                x0, y0, x1, y1 = box
+                touched[
+                    y0 // self.tile_height : y1 // self.tile_height + 1,
+                    x0 // self.tile_width : x1 // self.tile_width + 1,
+                ] = True
         return touched
 
     def plan(self, steps: list[Step], frame_dt: float, substeps: int) -> TilePlan:

@@ -30,15 +30,23 @@ def classify_interval(previous: float, current: float, max_interval: float) -> D
 
 @dataclass(frozen=True)
 class Step:
-    """dt seconds of constant input: ``segment`` deposits throughout, or None for pure decay.
+    """dt seconds of constant input: the ``segments`` active throughout (one per stream at most; none is
+    pure decay). A texel under several takes the largest coverage.
 
-    A catch-up step (``age`` not None) is the part of a late segment that lay before ``previous``: the
+    A catch-up step (``age`` not None) is the part of one late segment that lay before ``previous``: the
     history decayed over those dt seconds and then ``age`` more; the law's catch_up applies the deposit.
+    Late segments of different streams are caught up one after the other, which is exact wherever they do
+    not cover one texel during one span (a stream's own segments never overlap).
     """
 
     dt: float
-    segment: Segment | None
+    segments: tuple[Segment, ...] = ()
     age: float | None = None
+
+    @property
+    def pointer_seconds(self) -> float:
+        """Seconds of pointer input this step deposits, summed over its streams."""
+        return self.dt * len(self.segments)
 
 
 def late_steps(previous: float, segments: list[Segment], origin: float) -> list[Step]:
@@ -52,12 +60,13 @@ def late_steps(previous: float, segments: list[Segment], origin: float) -> list[
     for segment in segments:
         start, end = max(segment.t0, origin), min(segment.t1, previous)
         if end > start:
-            steps.append(Step(dt=end - start, segment=segment, age=previous - end))
+            steps.append(Step(dt=end - start, segments=(segment,), age=previous - end))
     return steps
 
 
 def split_interval(previous: float, current: float, segments: list[Segment]) -> list[Step]:
-    """Cut [previous, current) at every segment boundary inside it; segments are time-ordered, disjoint.
+    """Cut [previous, current) at every segment boundary inside it; each piece holds every segment active
+    throughout it (a stream's segments are time-ordered and disjoint; streams may overlap).
 
     A segment that began before ``previous`` contributes only its overlap with this interval: the part
     before ``previous`` belonged to an earlier interval (or was dropped by a discontinuity).
@@ -68,18 +77,28 @@ def split_interval(previous: float, current: float, segments: list[Segment]) -> 
     ordered = sorted(cuts)
     steps: list[Step] = []
     for s0, s1 in itertools.pairwise(ordered):
-        active = next((g for g in segments if g.t0 <= s0 and s1 <= g.t1 and g.t1 > g.t0), None)
-        steps.append(Step(dt=s1 - s0, segment=active))
+        active = tuple(g for g in segments if g.t0 <= s0 and s1 <= g.t1 and g.t1 > g.t0)
+        steps.append(Step(dt=s1 - s0, segments=active))
     return steps
 
 
-def chunk_steps(steps: list[Step], max_steps: int) -> list[list[Step]]:
-    """Dispatch-sized groups; each group ends in one storage write on the GPU."""
-    return [steps[i : i + max_steps] for i in range(0, len(steps), max_steps)]
+def chunk_steps(steps: list[Step], max_steps: int, max_pairs: int) -> list[list[Step]]:
+    """Dispatch-sized groups, in order: a group ends before it would hold more than ``max_steps`` steps
+    or ``max_pairs`` (step, segment) pairs; each group ends in one storage write on the GPU."""
+    chunks: list[list[Step]] = []
+    pairs = 0
+    for step in steps:
+        if not chunks or len(chunks[-1]) == max_steps or pairs + len(step.segments) > max_pairs:
+            chunks.append([])
+            pairs = 0
+        chunks[-1].append(step)
+        pairs += len(step.segments)
+    return chunks
 
 
 def validate_segment(segment: Segment, last_end: float | None) -> str | None:
-    """Why a queued segment is refused, or None: one pointer stream, time-ordered and non-overlapping."""
+    """Why a queued segment is refused, or None: finite, and time-ordered and non-overlapping within its
+    stream (``last_end``: where that stream's previous segment ended)."""
     values = (segment.t0, segment.t1, *segment.start, *segment.end, segment.pressure0, segment.pressure1)
     if not all(math.isfinite(v) for v in values):
         return "segment values must be finite"
@@ -89,4 +108,16 @@ def validate_segment(segment: Segment, last_end: float | None) -> str | None:
         return f"segment starts at {segment.t0}, before the previous one ended ({last_end})"
     if not (0.0 <= segment.pressure0 <= 1.0 and 0.0 <= segment.pressure1 <= 1.0):
         return "pressures must lie in [0, 1]"
+    return None
+
+
+def too_many_streams(segment: Segment, pending: list[Segment], max_streams: int) -> str | None:
+    """Why a segment is refused for the streams it would overlap, or None: at most ``max_streams`` other
+    streams' queued segments may overlap its span (a step holds at most one segment per stream)."""
+    others = {
+        g.stream for g in pending if g.stream != segment.stream and g.t0 < segment.t1 and segment.t0 < g.t1
+    }
+    if len(others) >= max_streams:
+        count, most = len(others), max_streams - 1
+        return f"segment of stream {segment.stream} would overlap {count} other streams (at most {most})"
     return None

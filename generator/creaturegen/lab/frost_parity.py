@@ -138,6 +138,86 @@ def _history_gates(lab: FrostLab, params: FrostParams, report: ParityReport) -> 
     report.measurements["historySize"] = list(size)
     report.measurements["format"] = info["format"]
     _late_arrival_gate(lab, params, report, size, storage, tolerance)
+    _strokes_at_once_gate(lab, params, report, size, storage, tolerance)
+
+
+#: Strokes of the several-at-once check: crossing wipes of their own streams, staggered in time.
+STROKES_AT_ONCE = 8
+
+
+def strokes_at_once(count: int, seconds: float = 0.5, pieces: int = 8) -> list[Segment]:
+    """``count`` streams wiping at once: stroke k runs from (0.1, v_k) to (0.9, 1 − v_k) and back (the
+    strokes cross near the middle, so texels there sit under several at once, and the way back re-enters
+    bins it thawed on the way out, partway through a frame), starting k·20 ms apart; in time order, as
+    pointers deliver them."""
+
+    def at(v: float, f: float) -> tuple[float, float]:
+        there = 1.0 - abs(1.0 - 2.0 * f)  # 0 → 1 → 0
+        return (0.1 + 0.8 * there, v + (1 - 2 * v) * there)
+
+    segments = []
+    for k in range(count):
+        v = 0.15 + 0.7 * k / max(count - 1, 1)
+        t0 = 0.02 * k
+        for j in range(pieces):
+            a, b = j / pieces, (j + 1) / pieces
+            segments.append(Segment(t0 + seconds * a, t0 + seconds * b, at(v, a), at(v, b), stream=k + 1))
+    return sorted(segments, key=lambda g: (g.t0, g.stream))
+
+
+def _strokes_at_once_gate(
+    lab: FrostLab,
+    params: FrostParams,
+    report: ParityReport,
+    size: tuple[int, int],
+    storage: Storage,
+    tolerance: float,
+) -> None:
+    """Several pointers at once (streams that overlap in time and cross in space): the GPU's binned update
+    vs numpy's unbinned one (a texel under several strokes takes the largest coverage); the bins' entries
+    and law evaluations per frame vs schedule.bin_steps (JS StepBins and Python count alike); and the
+    pointer time deposited, over the strokes' summed durations."""
+    lab.reset()
+    segments = strokes_at_once(STROKES_AT_ONCE)
+    reference = FrostReference(params, size[0], size[1], storage)
+    for segment in segments:
+        reference.queue(segment)
+    before = lab.counters()["effect"]["pointerSeconds"]
+    lab.queue(segments)
+    instants = [k / 60 for k in range(46)]
+    reports = lab.advance(instants)
+    for previous, current in itertools.pairwise(instants):
+        reference.update(previous, current)
+    expected = reference.counters.history[-len(reports) :]
+    report.gate(
+        f"GPU vs numpy history, {STROKES_AT_ONCE} strokes at once (60 FPS)",
+        float(np.abs(lab.history() - reference.state).max()),
+        tolerance,
+        "history units",
+    )
+    mismatched = sum(
+        int(r["binEntries"]) != e.bin_entries or int(r["texelSteps"]) != e.texel_steps
+        for r, e in zip(reports, expected, strict=True)
+    )
+    report.gate("frames whose bin entries or law evaluations differ from numpy's", mismatched, 0, "frames")
+    duration = sum(g.t1 - g.t0 for g in segments)
+    ratio = (lab.counters()["effect"]["pointerSeconds"] - before) / duration
+    report.gate(
+        f"pointer time deposited / summed duration, {STROKES_AT_ONCE} strokes at once",
+        abs(ratio - 1.0),
+        1e-9,
+        "|ratio - 1|",
+    )
+    entries = sum(int(r["binEntries"]) for r in reports)
+    steps = sum(int(r["texelSteps"]) for r in reports)
+    unbinned = sum(e.unbinned_texel_steps for e in expected)
+    report.measurements["strokesAtOnce"] = {
+        "strokes": STROKES_AT_ONCE,
+        "binEntries": entries,
+        "texelSteps": steps,
+        "unbinnedTexelSteps": unbinned,
+        "peakThaw": float(reference.state[..., 0].max()),
+    }
 
 
 #: GPU vs numpy tolerance per history format. rgba16float: one half-float ulp on [0.5, 1) (the format's own

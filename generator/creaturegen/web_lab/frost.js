@@ -13,6 +13,8 @@ const width = Number(params.get('w') ?? 256);
 const height = Number(params.get('h') ?? 160);
 // Where the package's assets are fetched from when not beside it (the package's assetBase option).
 const assetBase = params.get('assetBase') ?? undefined;
+// binning=0: the effect's unbinned baseline (bench/frost_strokes.py times both).
+const binning = params.get('binning') !== '0';
 const out = document.getElementById('out');
 
 // Count what the device creates, so "nothing created after reveal" is measured, not assumed.
@@ -51,7 +53,7 @@ async function main() {
   if (renderer.backend.isWebGPUBackend !== true) throw new Error('frost lab: three fell back to WebGL2; WebGPU is required');
   const pkg = await import(`/out/${slug}/index.js`);
   const { scene, camera } = labScene();
-  const effect = await pkg.createFrostEffect(renderer, scene, camera, { assetBase });
+  const effect = await pkg.createFrostEffect(renderer, scene, camera, { assetBase, binning });
   const device = renderer.backend.device;
 
   let clock = 0;
@@ -174,6 +176,18 @@ async function main() {
       }
       await device.queue.onSubmittedWorkDone();
       return performance.now() - start;
+    },
+    // Bench helper: each frame's update to GPU completion, in ms (p50/p95 need the frames one by one).
+    async timeFramesEach(instants) {
+      const ms = [];
+      for (let i = 0; i + 1 < instants.length; i++) {
+        await device.queue.onSubmittedWorkDone();
+        const start = performance.now();
+        effect.update(instants[i], instants[i + 1]);
+        await device.queue.onSubmittedWorkDone();
+        ms.push(performance.now() - start);
+      }
+      return ms;
     },
     // bench helpers. three advances its node frame once per requestAnimationFrame tick, and the scene pass
     // and the blur run once per node frame, so renders back to back in one task (timeFrames) redo only the

@@ -10,7 +10,10 @@ export function classifyInterval(previous, current, maxInterval) {
   return 'advance';
 }
 
-/** Why a segment is refused, or null: one pointer stream, time-ordered, non-overlapping, finite. */
+/**
+ * Why a segment is refused, or null: finite, and time-ordered and non-overlapping within its stream
+ * (`lastEnd`: where that stream's previous segment ended, or null).
+ */
 export function validateSegment(segment, lastEnd) {
   const values = [segment.t0, segment.t1, ...segment.start, ...segment.end, segment.pressure0, segment.pressure1];
   if (segment.start.length !== 2 || segment.end.length !== 2) return 'start and end must be [u, v]';
@@ -25,9 +28,24 @@ export function validateSegment(segment, lastEnd) {
   return null;
 }
 
-/** A segment with defaults filled in: pressures 1. */
-export function normalizeSegment({ t0, t1, start, end, pressure0 = 1, pressure1 = 1 }) {
-  return { t0, t1, start: [start[0], start[1]], end: [end[0], end[1]], pressure0, pressure1 };
+/**
+ * Why a segment is refused for the streams it would overlap, or null: at most maxStreams - 1 other
+ * streams' queued segments may overlap its span (a step holds at most one segment per stream).
+ */
+export function tooManyStreams(segment, pending, maxStreams) {
+  const others = new Set();
+  for (const g of pending) {
+    if (g.stream !== segment.stream && g.t0 < segment.t1 && segment.t0 < g.t1) others.add(g.stream);
+  }
+  if (others.size >= maxStreams) {
+    return `segment of stream ${segment.stream} would overlap ${others.size} other streams (at most ${maxStreams - 1})`;
+  }
+  return null;
+}
+
+/** A segment with defaults filled in: pressures 1, stream 0 (the pointer it came from). */
+export function normalizeSegment({ t0, t1, start, end, pressure0 = 1, pressure1 = 1, stream = 0 }) {
+  return { t0, t1, start: [start[0], start[1]], end: [end[0], end[1]], pressure0, pressure1, stream };
 }
 
 /** Pointer NDC in [-1, 1], y up, to history UV (origin top-left, v down). */
@@ -40,7 +58,10 @@ export function scaledSize(width, height, scale) {
   return [Math.max(1, Math.floor(width * scale + 0.5)), Math.max(1, Math.floor(height * scale + 0.5))];
 }
 
-/** Cut [previous, current) at every segment boundary inside it: piecewise-constant input intervals. */
+/**
+ * Cut [previous, current) at every segment boundary inside it: piecewise-constant input intervals, each
+ * holding every segment active throughout it (one per stream at most; a texel takes the largest coverage).
+ */
 export function splitInterval(previous, current, segments) {
   const cuts = [previous, current];
   for (const g of segments) {
@@ -52,8 +73,8 @@ export function splitInterval(previous, current, segments) {
   for (let i = 0; i + 1 < ordered.length; i++) {
     const s0 = ordered[i];
     const s1 = ordered[i + 1];
-    const active = segments.find((g) => g.t0 <= s0 && s1 <= g.t1 && g.t1 > g.t0) ?? null;
-    steps.push({ dt: s1 - s0, segment: active, age: null });
+    const active = segments.filter((g) => g.t0 <= s0 && s1 <= g.t1 && g.t1 > g.t0);
+    steps.push({ dt: s1 - s0, segments: active, age: null });
   }
   return steps;
 }
@@ -70,15 +91,139 @@ export function lateSteps(previous, segments, origin, from = 0) {
     const g = segments[i];
     const start = Math.max(g.t0, origin);
     const end = Math.min(g.t1, previous);
-    if (end > start) steps.push({ dt: end - start, segment: g, age: previous - end });
+    if (end > start) steps.push({ dt: end - start, segments: [g], age: previous - end });
   }
   return steps;
 }
 
-export function chunkSteps(steps, maxSteps) {
+/** Dispatch-sized groups: a group ends before it would hold more than maxSteps steps or maxPairs pairs. */
+export function chunkSteps(steps, maxSteps, maxPairs) {
   const chunks = [];
-  for (let i = 0; i < steps.length; i += maxSteps) chunks.push(steps.slice(i, i + maxSteps));
+  let pairs = 0;
+  for (const step of steps) {
+    const last = chunks[chunks.length - 1];
+    if (last === undefined || last.length === maxSteps || pairs + step.segments.length > maxPairs) {
+      chunks.push([step]);
+      pairs = step.segments.length;
+    } else {
+      last.push(step);
+      pairs += step.segments.length;
+    }
+  }
   return chunks;
+}
+
+/**
+ * Inclusive texel box [x0, y0, x1, y1] a segment's capsule can reach over dt, or null when it deposits
+ * nothing (no pressure, no time) or lies off the history.
+ */
+export function texelBox(g, dt, reach, width, height) {
+  if (0.5 * (g.pressure0 + g.pressure1) <= 0 || dt <= 0) return null;
+  const rx = (reach * height) / width;
+  const x0 = Math.max(Math.floor((Math.min(g.start[0], g.end[0]) - rx) * width), 0);
+  const x1 = Math.min(Math.floor((Math.max(g.start[0], g.end[0]) + rx) * width), width - 1);
+  const y0 = Math.max(Math.floor((Math.min(g.start[1], g.end[1]) - reach) * height), 0);
+  const y1 = Math.min(Math.floor((Math.max(g.start[1], g.end[1]) + reach) * height), height - 1);
+  return x0 > x1 || y0 > y1 ? null : [x0, y0, x1, y1];
+}
+
+/**
+ * The (step, segment) pairs of one chunk binned into square screen tiles of `size` texels, as a CSR list
+ * (start[b]..start[b+1] index `entries`, pair indices in step order): the GPU loops each texel over its
+ * bin's pairs only, so overlapping strokes cost sum over tiles of texels x entries, not every texel times
+ * every pair. Past `capacity` entries the chunk is one bin holding every pair (the unbinned cost, never a
+ * truncated list). Typed arrays are reused from frame to frame. Same counts as schedule.bin_steps.
+ */
+export class StepBins {
+  constructor(params) {
+    this.params = params;
+    this.start = new Uint32Array(1);
+    this.entries = new Uint32Array(0);
+    this.boxes = [];
+  }
+
+  /**
+   * Bin `chunk` on a width x height history; returns this (fields valid until the next call). `unbinned`:
+   * one bin holding every pair whatever the capacity (the baseline a benchmark compares with).
+   */
+  bin(chunk, width, height, unbinned = false) {
+    const size = this.params.tileSize;
+    const reach = Math.max(this.params.visible.radius, this.params.tilt.radius);
+    const binsX = Math.ceil(width / size);
+    const binsY = Math.ceil(height / size);
+    const count = binsX * binsY;
+    if (this.start.length < count + 1) this.start = new Uint32Array(count + 1);
+    const start = this.start;
+    start.fill(0, 0, count + 1);
+    this.boxes.length = 0;
+    let pairs = 0;
+    let total = 0;
+    for (const step of chunk) {
+      for (const g of step.segments) {
+        const box = texelBox(g, step.dt, reach, width, height);
+        this.boxes.push(box);
+        pairs += 1;
+        if (box === null) continue;
+        for (let by = Math.floor(box[1] / size); by <= Math.floor(box[3] / size); by++) {
+          for (let bx = Math.floor(box[0] / size); bx <= Math.floor(box[2] / size); bx++) {
+            start[by * binsX + bx + 1] += 1;
+            total += 1;
+          }
+        }
+      }
+    }
+    this.pairs = pairs;
+    this.width = width;
+    this.height = height;
+    this.single = unbinned || total > this.params.binCapacity;
+    if (this.single) {
+      this.size = Math.max(width, height);
+      this.binsX = 1;
+      this.count = 1;
+      this.total = pairs;
+      if (this.entries.length < pairs) this.entries = new Uint32Array(Math.max(pairs, 2 * this.entries.length));
+      start[0] = 0;
+      start[1] = pairs;
+      for (let i = 0; i < pairs; i++) this.entries[i] = i;
+      return this;
+    }
+    this.size = size;
+    this.binsX = binsX;
+    this.count = count;
+    this.total = total;
+    for (let b = 0; b < count; b++) start[b + 1] += start[b];
+    if (this.entries.length < total) this.entries = new Uint32Array(Math.max(total, 2 * this.entries.length));
+    const cursor = this.scratch?.length >= count ? this.scratch : (this.scratch = new Uint32Array(count));
+    cursor.set(start.subarray(0, count));
+    for (let i = 0; i < pairs; i++) {
+      const box = this.boxes[i];
+      if (box === null) continue;
+      for (let by = Math.floor(box[1] / size); by <= Math.floor(box[3] / size); by++) {
+        for (let bx = Math.floor(box[0] / size); bx <= Math.floor(box[2] / size); bx++) {
+          this.entries[cursor[by * binsX + bx]++] = i;
+        }
+      }
+    }
+    return this;
+  }
+
+  /**
+   * Law evaluations the dispatch makes: sum over bins of updated texels x entries. `updated(b)` says
+   * whether bin b's texels are dispatched (every bin under full-field; its tile under dirty tiles).
+   */
+  texelSteps(updated) {
+    let sum = 0;
+    for (let b = 0; b < this.count; b++) {
+      const entries = this.start[b + 1] - this.start[b];
+      if (entries === 0 || !updated(b)) continue;
+      const bx = b % this.binsX;
+      const by = Math.floor(b / this.binsX);
+      const w = Math.min(this.size, this.width - bx * this.size);
+      const h = Math.min(this.size, this.height - by * this.size);
+      sum += w * h * entries;
+    }
+    return sum;
+  }
 }
 
 /** Substeps keeping D·(dt/n)/dx² ≤ 1/4 with dx = 1/H; 0 without diffusion. */
@@ -116,21 +261,13 @@ export class TileScheduler {
     touched.fill(0);
     const reach = Math.max(this.params.visible.radius, this.params.tilt.radius);
     for (const step of steps) {
-      const g = step.segment;
-      if (g === null || 0.5 * (g.pressure0 + g.pressure1) <= 0 || step.dt <= 0) continue;
-      const rx = (reach * this.height) / this.width;
-      let x0 = Math.floor((Math.min(g.start[0], g.end[0]) - rx) * this.width);
-      let x1 = Math.floor((Math.max(g.start[0], g.end[0]) + rx) * this.width);
-      let y0 = Math.floor((Math.min(g.start[1], g.end[1]) - reach) * this.height);
-      let y1 = Math.floor((Math.max(g.start[1], g.end[1]) + reach) * this.height);
-      x0 = Math.max(x0, 0);
-      x1 = Math.min(x1, this.width - 1);
-      y0 = Math.max(y0, 0);
-      y1 = Math.min(y1, this.height - 1);
-      if (x0 > x1 || y0 > y1) continue;
-      for (let ty = Math.floor(y0 / this.tileHeight); ty <= Math.floor(y1 / this.tileHeight); ty++) {
-        for (let tx = Math.floor(x0 / this.tileWidth); tx <= Math.floor(x1 / this.tileWidth); tx++) {
-          touched[ty * this.tilesX + tx] = 1;
+      for (const g of step.segments) {
+        const box = texelBox(g, step.dt, reach, this.width, this.height);
+        if (box === null) continue;
+        for (let ty = Math.floor(box[1] / this.tileHeight); ty <= Math.floor(box[3] / this.tileHeight); ty++) {
+          for (let tx = Math.floor(box[0] / this.tileWidth); tx <= Math.floor(box[2] / this.tileWidth); tx++) {
+            touched[ty * this.tilesX + tx] = 1;
+          }
         }
       }
     }

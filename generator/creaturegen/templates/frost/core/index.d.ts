@@ -9,6 +9,12 @@ export interface PointerSegment {
   /** In [0, 1]; default 1. The segment deposits with the average of its two pressures. */
   pressure0?: number;
   pressure1?: number;
+  /**
+   * The pointer it came from (attachPointer uses the pointerId); default 0. A stream's segments are
+   * time-ordered and disjoint; streams may overlap in time (several strokes at once, up to
+   * `PLAN.params.maxStreams`), and a texel under several takes the largest coverage.
+   */
+  stream?: number;
 }
 
 /** A segment with its defaults filled in. */
@@ -19,18 +25,20 @@ export interface NormalizedSegment {
   end: [number, number];
   pressure0: number;
   pressure1: number;
+  stream: number;
 }
 
 export type IntervalDecision = 'advance' | 'none' | 'discontinuity';
 
 /**
- * One piecewise-constant input interval of a frame. A catch-up step (`age` a number) is the part of a late
- * segment that lay before the frame's previous instant: the history decayed over those `dt` seconds and
- * `age` more, and the law's catch-up form deposits it exactly.
+ * One piecewise-constant input interval of a frame: the segments active throughout it (one per stream at
+ * most; none is pure decay). A catch-up step (`age` a number) is the part of one late segment that lay
+ * before the frame's previous instant: the history decayed over those `dt` seconds and `age` more, and the
+ * law's catch-up form deposits it exactly.
  */
 export interface FrameStep {
   dt: number;
-  segment: NormalizedSegment | null;
+  segments: NormalizedSegment[];
   age: number | null;
 }
 
@@ -59,6 +67,12 @@ export interface FrostParams {
   tolerance: number;
   maxInterval: number;
   maxSteps: number;
+  /** (step, segment) pairs per update dispatch; a chunk ends before it would hold more. */
+  maxPairs: number;
+  /** Pointer streams that may deposit at once. */
+  maxStreams: number;
+  /** Bin entries per dispatch; past it a chunk is one bin (the unbinned cost). */
+  binCapacity: number;
   discontinuity: 'reset' | 'freeze';
   resizePolicy: 'clear' | 'preserve-remap';
   historyScale: number;
@@ -119,8 +133,12 @@ export const PLAN: FrostPlan;
 
 /** 'advance' | 'none' (equal instants) | 'discontinuity' (reversed, non-finite or too long). */
 export function classifyInterval(previous: number, current: number, maxInterval: number): IntervalDecision;
-/** Why a segment is refused, or null. */
+/** Why a segment is refused, or null (`lastEnd`: where its stream's previous segment ended). */
 export function validateSegment(segment: NormalizedSegment, lastEnd: number | null): string | null;
+/** Why a segment is refused for overlapping `maxStreams` or more other streams' queued segments, or null. */
+export function tooManyStreams(
+  segment: NormalizedSegment, pending: readonly NormalizedSegment[], maxStreams: number,
+): string | null;
 export function normalizeSegment(segment: PointerSegment): NormalizedSegment;
 /** Pointer NDC in [-1, 1], y up, to history UV (origin top-left, v down). */
 export function pointerUV(ndcX: number, ndcY: number): [number, number];
@@ -132,7 +150,28 @@ export function splitInterval(previous: number, current: number, segments: reado
 export function lateSteps(
   previous: number, segments: readonly NormalizedSegment[], origin: number, from?: number,
 ): FrameStep[];
-export function chunkSteps(steps: readonly FrameStep[], maxSteps: number): FrameStep[][];
+/** Dispatch-sized groups: each ends before it would hold more than maxSteps steps or maxPairs pairs. */
+export function chunkSteps(steps: readonly FrameStep[], maxSteps: number, maxPairs: number): FrameStep[][];
+/** Inclusive texel box [x0, y0, x1, y1] a segment's capsule reaches over dt, or null. */
+export function texelBox(
+  segment: NormalizedSegment, dt: number, reach: number, width: number, height: number,
+): [number, number, number, number] | null;
+
+/** The pairs of one chunk binned into screen tiles (CSR), reused from frame to frame. */
+export class StepBins {
+  constructor(params: FrostParams);
+  bin(chunk: readonly FrameStep[], width: number, height: number, unbinned?: boolean): this;
+  /** Law evaluations of the dispatch: sum over updated bins of texels × entries. */
+  texelSteps(updated: (bin: number) => boolean): number;
+  readonly single: boolean;
+  readonly size: number;
+  readonly binsX: number;
+  readonly count: number;
+  readonly pairs: number;
+  readonly total: number;
+  readonly start: Uint32Array;
+  readonly entries: Uint32Array;
+}
 /** Substeps keeping D·(dt/n)/dx² ≤ 1/4; 0 without diffusion. */
 export function diffusionSubsteps(diffusivity: number, dt: number, height: number, stability: number): number;
 

@@ -15,8 +15,8 @@ import { checkThreeRevision } from '../core/revision.js';
 import { FrostAssetError, decodeStructureFile } from '../core/structure-file.js';
 import { assetUrl } from './assets.js';
 import {
-  TileScheduler, chunkSteps, classifyInterval, diffusionSubsteps, lateSteps, normalizeSegment, scaledSize,
-  splitInterval, validateSegment,
+  StepBins, TileScheduler, chunkSteps, classifyInterval, diffusionSubsteps, lateSteps, normalizeSegment, scaledSize,
+  splitInterval, tooManyStreams, validateSegment,
 } from '../core/frost-core.js';
 import { SeparableBlurNode } from './separable-blur.js';
 
@@ -142,12 +142,17 @@ export async function createFrostEffect(renderer, scene, camera, options = {}) {
   const pending = [];
   let freshFrom = 0; // pending[freshFrom..] were queued since the last update
   let origin = null; // where the history's timeline starts: late segments deposit nothing before it
-  let lastEnd = null;
+  const lastEnd = new Map(); // stream -> where its latest segment ended
+  const bins = new StepBins(params);
+  const binning = options.binning !== false;
 
   const uHistW = uniform(histW, 'int');
   const uHistH = uniform(histH, 'int');
   const uHistSize = uniform(new Vector2(histW, histH));
   const uStepCount = uniform(0, 'int');
+  const uBinSize = uniform(params.tileSize, 'int');
+  const uBinsX = uniform(1, 'int');
+  const uDecayTotal = uniform(0); // seconds of ordinary (not catch-up) steps in the chunk
   const uFirstChunk = uniform(1);
   const uTileW = uniform(histW, 'int');
   const uTileH = uniform(histH, 'int');
@@ -159,10 +164,17 @@ export async function createFrostEffect(renderer, scene, camera, options = {}) {
   const uOldH = uniform(1, 'int');
 
   const maxSteps = params.maxSteps;
-  // Per step: [a.u, a.v, b.u, b.v] and [dt, pressure, hasSegment, age]; vec4 because the CPU writes it.
-  // age >= 0 marks a catch-up step (the late part of a segment, see lateSteps), -1 an ordinary one.
-  const stepBuffer = instancedArray(maxSteps * 2, 'vec4');
+  // Per step: [dt, age, decayBefore, 0]: age >= 0 marks a catch-up step (the late part of a segment, see
+  // lateSteps), -1 an ordinary one; decayBefore is the ordinary seconds of the chunk's earlier steps.
+  const stepBuffer = instancedArray(maxSteps, 'vec4');
   const stepData = stepBuffer.value.array;
+  // Per (step, segment) pair: [a.u, a.v, b.u, b.v] and [pressure, step, 0, 0].
+  const pairBuffer = instancedArray(params.maxPairs * 2, 'vec4');
+  const pairData = pairBuffer.value.array;
+  // The chunk's pairs binned into tileSize tiles (StepBins, a CSR list): texels loop over their bin only.
+  const binCapacity = Math.ceil(4096 / params.tileSize) ** 2 + 1;
+  const binStartBuffer = instancedArray(new Uint32Array(binCapacity), 'uint');
+  const binEntryBuffer = instancedArray(new Uint32Array(params.binCapacity), 'uint');
   // Fixed capacity (a storage buffer cannot grow in place): every tile of a 4096² history.
   const tileCapacity = Math.max(scheduler.count, Math.ceil(4096 / params.tileSize) ** 2);
   const tileBuffer = instancedArray(new Uint32Array(tileCapacity), 'uint');
@@ -176,6 +188,10 @@ export async function createFrostEffect(renderer, scene, camera, options = {}) {
 
   const texelNoise = (i, j, salt) => float(pcg(j.add(pcg(i.add(salt)))).shiftRight(uint(8))).mul(1 / 16777216);
 
+  // One texel over its bin's pairs, in step order. A step with no pair in the bin covers no texel of it:
+  // an ordinary one only decays (folded into one exp over the gap, from the chunk's decayBefore times), a
+  // catch-up one is the identity. A step with pairs deposits the largest coverage among them (several
+  // strokes at once). The sentinel iteration (i = last) applies the bin's final step.
   const updateTexel = (src, dst, ix, iy) => {
     const prev = src.load(ivec2(ix, iy));
     const xr = prev.x.toVar();
@@ -186,27 +202,51 @@ export async function createFrostEffect(renderer, scene, camera, options = {}) {
     const p = vec2(float(ix).add(0.5).div(uHistSize.x).mul(aspect), float(iy).add(0.5).div(uHistSize.y));
     const n0 = texelNoise(uint(ix), uint(iy), salts[0]);
     const n1 = texelNoise(uint(ix), uint(iy), salts[1]);
-    Loop(uStepCount, ({ i }) => {
-      const seg = stepBuffer.element(i.mul(2));
-      const info = stepBuffer.element(i.mul(2).add(1));
-      const a = vec2(seg.x.mul(aspect), seg.y);
-      const d = vec2(seg.z.mul(aspect), seg.w).sub(a);
-      const t = clamp(dot(p.sub(a), d).div(max(dot(d, d), float(1e-30))), 0, 1);
-      const dist = length(p.sub(a).sub(d.mul(t)));
-      const weight = info.y.mul(info.z);
-      const br = weight.mul(float(1).sub(smoothstep(vis.radius * (1 - params.softness), vis.radius, dist)))
-        .mul(float(1).sub(n0.mul(vis.noise)));
-      const ba = weight.mul(float(1).sub(smoothstep(tilt.radius * (1 - params.softness), tilt.radius, dist)))
-        .mul(float(1).sub(n1.mul(tilt.noise)));
-      dr.assign(max(dr, br));
-      da.assign(max(da, ba));
-      const late = info.w.greaterThanEqual(0);
-      const age = max(info.w, float(0));
-      xr.assign(select(late, catchUp(xr, br, info.x, age, float(vis.decay), float(vis.fill)),
-        law(xr, br, info.x, float(vis.decay), float(vis.fill))));
-      xa.assign(select(late, catchUp(xa, ba, info.x, age, float(tilt.decay), float(tilt.fill)),
-        law(xa, ba, info.x, float(tilt.decay), float(tilt.fill))));
+    const bin = iy.div(uBinSize).mul(uBinsX).add(ix.div(uBinSize));
+    const first = int(binStartBuffer.element(bin));
+    const last = int(binStartBuffer.element(bin.add(1)));
+    const elapsed = float(0).toVar(); // ordinary seconds of the chunk already applied
+    const step = int(-1).toVar();
+    const br = float(0).toVar();
+    const ba = float(0).toVar();
+    Loop({ start: first, end: last.add(1), type: 'int', condition: '<' }, ({ i }) => {
+      const atEnd = i.greaterThanEqual(last);
+      const pair = int(binEntryBuffer.element(min(i, max(last.sub(1), int(0)))));
+      const info = pairBuffer.element(pair.mul(2).add(1));
+      const next = select(atEnd, uStepCount, int(info.y));
+      If(next.notEqual(step).and(step.greaterThanEqual(0)), () => {
+        const s = stepBuffer.element(step);
+        xr.mulAssign(exp(float(-vis.decay).mul(s.z.sub(elapsed))));
+        xa.mulAssign(exp(float(-tilt.decay).mul(s.z.sub(elapsed))));
+        dr.assign(max(dr, br));
+        da.assign(max(da, ba));
+        const late = s.y.greaterThanEqual(0);
+        const age = max(s.y, float(0));
+        xr.assign(select(late, catchUp(xr, br, s.x, age, float(vis.decay), float(vis.fill)),
+          law(xr, br, s.x, float(vis.decay), float(vis.fill))));
+        xa.assign(select(late, catchUp(xa, ba, s.x, age, float(tilt.decay), float(tilt.fill)),
+          law(xa, ba, s.x, float(tilt.decay), float(tilt.fill))));
+        elapsed.assign(s.z.add(select(late, float(0), s.x)));
+      });
+      If(next.notEqual(step), () => {
+        step.assign(next);
+        br.assign(0);
+        ba.assign(0);
+      });
+      If(atEnd.not(), () => {
+        const seg = pairBuffer.element(pair.mul(2));
+        const a = vec2(seg.x.mul(aspect), seg.y);
+        const d = vec2(seg.z.mul(aspect), seg.w).sub(a);
+        const t = clamp(dot(p.sub(a), d).div(max(dot(d, d), float(1e-30))), 0, 1);
+        const dist = length(p.sub(a).sub(d.mul(t)));
+        br.assign(max(br, info.x.mul(float(1).sub(smoothstep(vis.radius * (1 - params.softness), vis.radius, dist)))
+          .mul(float(1).sub(n0.mul(vis.noise)))));
+        ba.assign(max(ba, info.x.mul(float(1).sub(smoothstep(tilt.radius * (1 - params.softness), tilt.radius, dist)))
+          .mul(float(1).sub(n1.mul(tilt.noise)))));
+      });
     });
+    xr.mulAssign(exp(float(-vis.decay).mul(uDecayTotal.sub(elapsed))));
+    xa.mulAssign(exp(float(-tilt.decay).mul(uDecayTotal.sub(elapsed))));
     textureStore(dst, ivec2(ix, iy), vec4(xr, dr, da, xa));
   };
 
@@ -464,30 +504,58 @@ export async function createFrostEffect(renderer, scene, camera, options = {}) {
     runLinear(kernels.clear, scheduler.count);
   }
 
-  function writeSteps(chunk) {
-    // Element writes, no temporary arrays: this runs every frame.
+  // Element writes into reused typed arrays, no temporaries beyond StepBins' own: this runs every frame.
+  function writeChunk(chunk) {
+    let decay = 0;
+    let pair = 0;
     for (let i = 0; i < chunk.length; i++) {
-      const g = chunk[i].segment;
-      const o = i * 8;
-      stepData[o] = g ? g.start[0] : 0;
-      stepData[o + 1] = g ? g.start[1] : 0;
-      stepData[o + 2] = g ? g.end[0] : 0;
-      stepData[o + 3] = g ? g.end[1] : 0;
-      stepData[o + 4] = chunk[i].dt;
-      stepData[o + 5] = g ? 0.5 * (g.pressure0 + g.pressure1) : 0;
-      stepData[o + 6] = g ? 1 : 0;
-      stepData[o + 7] = chunk[i].age ?? -1;
+      const step = chunk[i];
+      const late = step.age !== null && step.age !== undefined;
+      stepData[i * 4] = step.dt;
+      stepData[i * 4 + 1] = late ? step.age : -1;
+      stepData[i * 4 + 2] = decay;
+      stepData[i * 4 + 3] = 0;
+      if (!late) decay += step.dt;
+      for (const g of step.segments) {
+        const o = pair * 8;
+        pairData[o] = g.start[0];
+        pairData[o + 1] = g.start[1];
+        pairData[o + 2] = g.end[0];
+        pairData[o + 3] = g.end[1];
+        pairData[o + 4] = 0.5 * (g.pressure0 + g.pressure1);
+        pairData[o + 5] = i;
+        pairData[o + 6] = 0;
+        pairData[o + 7] = 0;
+        pair += 1;
+      }
     }
-    stepBuffer.value.addUpdateRange(0, chunk.length * 8);
+    stepBuffer.value.addUpdateRange(0, Math.max(chunk.length, 1) * 4);
     stepBuffer.value.needsUpdate = true;
+    if (pair > 0) {
+      pairBuffer.value.addUpdateRange(0, pair * 8);
+      pairBuffer.value.needsUpdate = true;
+    }
+    bins.bin(chunk, histW, histH, !binning);
+    const starts = binStartBuffer.value.array;
+    starts.set(bins.start.subarray(0, bins.count + 1));
+    binStartBuffer.value.addUpdateRange(0, bins.count + 1);
+    binStartBuffer.value.needsUpdate = true;
+    if (bins.total > 0) {
+      binEntryBuffer.value.array.set(bins.entries.subarray(0, bins.total));
+      binEntryBuffer.value.addUpdateRange(0, bins.total);
+      binEntryBuffer.value.needsUpdate = true;
+    }
+    uBinSize.value = bins.size;
+    uBinsX.value = bins.binsX;
     uStepCount.value = chunk.length;
+    uDecayTotal.value = decay;
   }
 
   function update(previousInstant, currentInstant) {
     const decision = classifyInterval(previousInstant, currentInstant, params.maxInterval);
     const report = {
       decision, steps: 0, dispatches: 0, texels: 0, updateTiles: 0, retiredTiles: 0, substeps: 0, lateSteps: 0,
-      pointerSeconds: 0,
+      pointerSeconds: 0, binEntries: 0, texelSteps: 0,
     };
     if (decision === 'none') return report;
     counters.frames += 1;
@@ -496,7 +564,7 @@ export async function createFrostEffect(renderer, scene, camera, options = {}) {
       counters.discontinuities += 1;
       pending.length = 0;
       freshFrom = 0;
-      lastEnd = null; // time jumped: the next segment may start anywhere
+      lastEnd.clear(); // time jumped: the next segment may start anywhere
       if (params.discontinuity === 'reset') reset();
       origin = currentInstant; // after reset(): nothing queued later deposits before the jump's end
       report.dispatches = counters.dispatches - before;
@@ -511,7 +579,7 @@ export async function createFrostEffect(renderer, scene, camera, options = {}) {
     const split = splitInterval(previousInstant, currentInstant, pending);
     const steps = late.length > 0 ? late.concat(split) : split;
     let pointerSeconds = 0;
-    for (let i = 0; i < steps.length; i++) if (steps[i].segment !== null) pointerSeconds += steps[i].dt;
+    for (let i = 0; i < steps.length; i++) pointerSeconds += steps[i].dt * steps[i].segments.length;
     const substeps = diffusionSubsteps(params.diffusivity, frameDt, histH, params.diffusionStability);
     const { updateCount, retireCount } = scheduler.plan(steps, frameDt, substeps);
     const tileArea = scheduler.tileWidth * scheduler.tileHeight;
@@ -528,8 +596,13 @@ export async function createFrostEffect(renderer, scene, camera, options = {}) {
     if (updateCount > 0) {
       const full = params.policy === 'full-field';
       if (!full) uploadTiles(scheduler.update, updateCount);
-      chunkSteps(steps, maxSteps).forEach((chunk, index) => {
-        writeSteps(chunk);
+      const updated = full ? () => true : (b) => scheduler.live[b] === 1;
+      chunkSteps(steps, maxSteps, params.maxPairs).forEach((chunk, index) => {
+        writeChunk(chunk);
+        report.binEntries += bins.total;
+        report.texelSteps += bins.single
+          ? bins.total * (full ? histW * histH : liveTexels(updateCount))
+          : bins.texelSteps(updated);
         uFirstChunk.value = index === 0 ? 1 : 0;
         if (full) run(kernels.update2d[current], dispatch2d());
         else runLinear(kernels.updateTiles[current], updateCount);
@@ -558,31 +631,44 @@ export async function createFrostEffect(renderer, scene, camera, options = {}) {
     return report;
   }
 
+  // Texels of the first `count` update tiles, clipped to the history (what a single-bin chunk evaluates).
+  function liveTexels(count) {
+    let sum = 0;
+    for (let k = 0; k < count; k++) {
+      const t = scheduler.update[k];
+      const x0 = (t % scheduler.tilesX) * scheduler.tileWidth;
+      const y0 = Math.floor(t / scheduler.tilesX) * scheduler.tileHeight;
+      sum += Math.min(scheduler.tileWidth, histW - x0) * Math.min(scheduler.tileHeight, histH - y0);
+    }
+    return sum;
+  }
+
   function pointer(segment) {
     const g = normalizeSegment(segment);
-    const problem = validateSegment(g, lastEnd);
+    const problem = validateSegment(g, lastEnd.get(g.stream) ?? null) ?? tooManyStreams(g, pending, params.maxStreams);
     if (problem !== null) {
       counters.segmentsRejected += 1;
       throw new Error(`frost.pointer: ${problem}`);
     }
     pending.push(g);
-    lastEnd = g.t1;
+    lastEnd.set(g.stream, g.t1);
     counters.segmentsQueued += 1;
   }
 
   /**
-   * Wire a real pointer: one segment between successive samples of a press (coalesced events included),
-   * captured on pointerdown, ending on pointerup/cancel. Instants are `clock(event.timeStamp)`, by default
-   * event.timeStamp / 1000: seconds on the same clock as requestAnimationFrame's timestamp / 1000, which is
-   * what the frame loop must pass to update(previous, current). Positions map to history UV through the
-   * element's bounding rect (origin top-left). Pressure: pen and touch report it; a mouse is 1 while its
-   * primary button is down; the release sample keeps the last pressure (contact lasted until then).
+   * Wire real pointers: one segment between successive samples of a press (coalesced events included),
+   * captured on pointerdown, ending on pointerup/cancel. Every pointer that is down is its own stream
+   * (stream = event.pointerId), so two fingers or a pen and a mouse wipe at once. Instants are
+   * `clock(event.timeStamp)`, by default event.timeStamp / 1000: seconds on the same clock as
+   * requestAnimationFrame's timestamp / 1000, which is what the frame loop must pass to
+   * update(previous, current). Positions map to history UV through the element's bounding rect (origin
+   * top-left). Pressure: pen and touch report it; a mouse is 1 while its primary button is down; the
+   * release sample keeps the last pressure (contact lasted until then).
    */
   function attachPointer(element, attachOptions = {}) {
     const clock = attachOptions.clock ?? ((timeStampMs) => timeStampMs / 1000);
     const onSegment = attachOptions.onSegment ?? null;
-    let active = null; // pointerId of the press being drawn
-    let last = null; // { t, uv, p } of the latest sample of that press
+    const presses = new Map(); // pointerId -> { t, uv, p } of the latest sample of that press
     const sampleOf = (event, pressure) => {
       const rect = element.getBoundingClientRect();
       const u = (event.clientX - rect.left) / Math.max(rect.width, 1e-9);
@@ -590,13 +676,16 @@ export async function createFrostEffect(renderer, scene, camera, options = {}) {
       return { t: clock(event.timeStamp), uv: [u, v], p: Math.min(Math.max(pressure, 0), 1) };
     };
     const pressureOf = (event) => (event.pointerType === 'mouse' ? 1 : event.pressure);
-    const extend = (next) => {
+    const extend = (id, next) => {
+      const last = presses.get(id);
       if (!(next.t > last.t)) {
-        if (next.t === last.t) last = { t: last.t, uv: next.uv, p: next.p };
+        if (next.t === last.t) presses.set(id, { t: last.t, uv: next.uv, p: next.p });
         return;
       }
-      const segment = { t0: last.t, t1: next.t, start: last.uv, end: next.uv, pressure0: last.p, pressure1: next.p };
-      last = next;
+      const segment = {
+        t0: last.t, t1: next.t, start: last.uv, end: next.uv, pressure0: last.p, pressure1: next.p, stream: id,
+      };
+      presses.set(id, next);
       try {
         pointer(segment);
       } catch {
@@ -605,22 +694,20 @@ export async function createFrostEffect(renderer, scene, camera, options = {}) {
       if (onSegment !== null) onSegment(normalizeSegment(segment));
     };
     const down = (event) => {
-      if (active !== null || (event.pointerType === 'mouse' && event.button !== 0)) return;
-      active = event.pointerId;
-      last = sampleOf(event, pressureOf(event));
+      if (presses.has(event.pointerId) || (event.pointerType === 'mouse' && event.button !== 0)) return;
+      presses.set(event.pointerId, sampleOf(event, pressureOf(event)));
       try { element.setPointerCapture(event.pointerId); } catch { /* element not connected: no capture */ }
     };
     const move = (event) => {
-      if (event.pointerId !== active) return;
+      if (!presses.has(event.pointerId)) return;
       const coalesced = typeof event.getCoalescedEvents === 'function' ? event.getCoalescedEvents() : [];
       const samples = coalesced.length > 0 ? coalesced : [event];
-      for (const e of samples) extend(sampleOf(e, pressureOf(e)));
+      for (const e of samples) extend(event.pointerId, sampleOf(e, pressureOf(e)));
     };
     const up = (event) => {
-      if (event.pointerId !== active) return;
-      extend(sampleOf(event, last.p));
-      active = null;
-      last = null;
+      if (!presses.has(event.pointerId)) return;
+      extend(event.pointerId, sampleOf(event, presses.get(event.pointerId).p));
+      presses.delete(event.pointerId);
     };
     const previousTouchAction = element.style.touchAction;
     element.style.touchAction = 'none'; // touch drags reach us as pointer events instead of scrolling
@@ -634,11 +721,10 @@ export async function createFrostEffect(renderer, scene, camera, options = {}) {
       element.removeEventListener('pointerup', up);
       element.removeEventListener('pointercancel', up);
       element.style.touchAction = previousTouchAction;
-      if (active !== null) {
-        try { element.releasePointerCapture(active); } catch { /* already released */ }
+      for (const id of presses.keys()) {
+        try { element.releasePointerCapture(id); } catch { /* already released */ }
       }
-      active = null;
-      last = null;
+      presses.clear();
     };
   }
 
@@ -710,7 +796,7 @@ export async function createFrostEffect(renderer, scene, camera, options = {}) {
     pending.length = 0;
     freshFrom = 0;
     origin = null;
-    lastEnd = null;
+    lastEnd.clear();
     scheduler = new TileScheduler(params, histW, histH);
     clearAll();
     current = 0;
