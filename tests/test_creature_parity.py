@@ -337,6 +337,31 @@ def test_the_job_catches_a_spawn_that_creates_a_buffer(out_root: Path, tmp_path:
 
 
 @pytest.mark.browser
+def test_the_job_catches_a_spawn_that_spreads_bodies_over_pages(out_root: Path, tmp_path: Path) -> None:
+    """Each page is one draw per pass: a spawn that deals bodies round-robin over the pages instead of
+    filling the first free slot uses every page for nine bodies, and the pages-in-use gate fails."""
+    package = build("reference/hopper.json", out_root)
+    planted = _planted(
+        package,
+        tmp_path,
+        "population.js",
+        [
+            (
+                "      for (const page of pages) {\n        for (let j = 0; j < page.size; j++) {\n"
+                "          if (page.alive[j]) continue;\n          const genome",
+                "      const turn = population.count % pages.length;\n"
+                "      for (const page of [...pages.slice(turn), ...pages.slice(0, turn)]) {\n"
+                "        for (let j = 0; j < page.size; j++) {\n"
+                "          if (page.alive[j]) continue;\n          const genome",
+            )
+        ],
+    )
+    report = run_creature_parity(planted, groups=("population",))
+    failed = {g["name"] for g in report.gates if g["status"] == "fail"}
+    assert f"pose pages in use after {SPAWNS} spawns of pageSize {PAGE_SIZE}" in failed, report.summary()
+
+
+@pytest.mark.browser
 def test_the_job_catches_a_wrong_gradient(out_root: Path, tmp_path: Path) -> None:
     """A blend gradient with its y component doubled leaves every distance right and every normal wrong."""
     package = build("reference/hopper.json", out_root)

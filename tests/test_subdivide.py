@@ -17,7 +17,7 @@ from creaturegen.surface import topology
 from creaturegen.surface.field64 import newton_project
 from creaturegen.surface.gates import mesh_gates, vertex_areas, weighted_percentile
 from creaturegen.surface.mesh import Mesh, angles_deg
-from creaturegen.surface.subdivide import normal_departures, split_faces, subdivide_to_field
+from creaturegen.surface.subdivide import TAIL_MARKS, normal_departures, split_faces, subdivide_to_field
 
 F64 = npt.NDArray[np.float64]
 R, r, K = 0.3, 0.16, 0.02
@@ -181,3 +181,18 @@ def test_dense_vertices_do_not_outvote_the_surface() -> None:
     assert by_count > gates["vertexNormalAngleP99"].threshold
     assert gates["vertexNormalAngleP99"].passed, gates["vertexNormalAngleP99"]
     assert not gates["vertexNormalAngleMax"].passed
+
+
+def test_the_tail_pass_splits_what_the_first_leaves_under_its_marks(fillet: Mesh) -> None:
+    """After the first pass (almost) nothing departs past its marks (10°/20°), yet a p99 can still sit
+    over its bound; the tail pass marks at the p99 bounds themselves and lowers both p99s further."""
+    first, _, _ = subdivide_to_field(fillet, _field)
+    _, again, _ = subdivide_to_field(first, _field)
+    tail, more, _ = subdivide_to_field(first, _field, marks=TAIL_MARKS)
+    assert more > 10 * max(again, 1)  # the first pass's marks have (almost) nothing left
+    vertex, _face = normal_departures(tail, _gradient)
+    assert vertex.max() <= normal_departures(first, _gradient)[0].max()
+    before, after = _gates(first), _gates(tail)
+    assert after["vertexNormalAngleP99"] < before["vertexNormalAngleP99"]
+    assert after["faceNormalAngleP99"] <= before["faceNormalAngleP99"]
+    assert topology.components(tail).euler.tolist() == [2]

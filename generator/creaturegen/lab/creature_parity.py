@@ -77,9 +77,12 @@ FOOT_DRIFT_TOL = 1e-5
 #: 65 s for 51 beetles of 65,410 vertices), and a bigger page adds nothing the gates could see.
 PAGE_SIZE = 8
 SPAWNS = PAGE_SIZE
-#: Pages the burst's bodies occupy; also the lab's capacity in pages unless the genetics grid runs (its
-#: GRID_SIDE² bodies need more, and the preload warms every page, one body each, so capacity costs time).
+#: Pages the burst's bodies occupy. The lab holds one page more unless the genetics grid runs (its GRID_SIDE²
+#: bodies need more): with exactly two pages the pages-in-use gate could not fail, since nine bodies need
+#: both; a third page lets a spawn that spreads bodies over pages show (the preload warms every page, one
+#: body each, so capacity costs time).
 PAGES_IN_BURST = 2
+SPARE_PAGES = 1
 #: The genetics grid: side, first seed, spacing (body lengths) and the tick it is compared at.
 GRID_SIDE = 8
 GRID_SEED = 0
@@ -590,7 +593,7 @@ def run_creature_parity(
     (package / "parity").mkdir(exist_ok=True)
     seconds: dict[str, float] = {}
     start = time.perf_counter()
-    capacity = GRID_SIDE * GRID_SIDE if "grid" in groups else PAGES_IN_BURST * PAGE_SIZE
+    capacity = GRID_SIDE * GRID_SIDE if "grid" in groups else (PAGES_IN_BURST + SPARE_PAGES) * PAGE_SIZE
     with open_creature_lab_page(package, canvas, capacity=capacity, pageSize=PAGE_SIZE) as lab_page:
         page = lab_page.page
         seconds["load"] = time.perf_counter() - start

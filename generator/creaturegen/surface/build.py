@@ -58,7 +58,7 @@ from .skin_tier import (
     skin_contract,
     skin_departures,
 )
-from .subdivide import analytic_normals, subdivide_to_field
+from .subdivide import MARK_FACE_DEG, MARK_VERTEX_DEG, TAIL_MARKS, analytic_normals, subdivide_to_field
 from .topology import components
 from .weights import SkinWeights, skin_weights
 
@@ -86,6 +86,8 @@ CREASE_BAND_CELLS = 2.0
 NORMAL_GATES = frozenset(
     {"vertexNormalAngleMax", "vertexNormalAngleP99", "faceNormalAngleMax", "faceNormalAngleP99", "inverted"}
 )
+#: The area-weighted tails among them: a second, finer split pass answers these (subdivide.TAIL_MARKS).
+P99_GATES = frozenset({"vertexNormalAngleP99", "faceNormalAngleP99"})
 #: Finer lattices tried (each √2 finer) when a mesh gate fails before the build gives up ...
 MAX_REFINEMENTS = 2
 #: ... and further ones, up to EXTRA_REFINEMENTS more, while the lattice stays under SMALL_LATTICE_NODES
@@ -604,42 +606,54 @@ def _remedied(
     alone are gated only when the sum is not kept."""
     flipped_mesh, flips = flip_to_field(ex.mesh, rest_field.gradient)
     flipped = replace(ex, mesh=flipped_mesh)
-    tried_split = False
-    if set(failed) <= NORMAL_GATES:
-        tried_split = True
-        split, added, declined = _split_toward_field(flipped, rest_field)
-        if added:
-            kept, result = _judged(rig, split, gates, policy, failed, rest_field, skeleton, grid)
+
+    def split(base: Extraction, flipped_too: int) -> Remedy | None:
+        """``base`` split toward the field and gated against the current failures: the result if kept.
+        While a p99 gate still fails, its tail is split too (subdivide.TAIL_MARKS) and kept if no worse."""
+        best: Remedy | None = None
+        against = failed
+        for marks in ((MARK_VERTEX_DEG, MARK_FACE_DEG), TAIL_MARKS):
+            if marks == TAIL_MARKS and not set(against) & P99_GATES:
+                break
+            candidate, added, declined = _split_toward_field(
+                base if best is None else best[0], rest_field, marks
+            )
+            if not added:
+                continue
+            kept, result = _judged(rig, candidate, against, rest_field, skeleton, grid)
+            what = (
+                "where the normals disagree"
+                if marks != TAIL_MARKS
+                else "where the normals pass the p99 bounds"
+            )
+            lead = f"{flipped_too} edges flipped and {added} split" if flipped_too else f"{added} edges split"
             progress(
-                f"{flips} edges flipped and {added} split toward the field where the normals disagree "
-                f"({declined} marked triangles declined: a midpoint there would not reach the zero set): "
-                + _verdict(result, kept)
+                f"{lead} toward the field {what} ({declined} marked triangles declined: a midpoint there "
+                "would not reach the zero set): " + _verdict(result, kept)
             )
             if kept:
-                return result
+                best, against, flipped_too = result, result[3], 0
+        return best
+
+    only_normals = set(failed) <= NORMAL_GATES
+    if only_normals and (both := split(flipped, flips)) is not None:
+        return both
     if flips:
-        kept, result = _judged(rig, flipped, gates, policy, failed, rest_field, skeleton, grid)
+        kept, result = _judged(rig, flipped, failed, rest_field, skeleton, grid)
         progress(f"{flips} edges flipped toward the field: " + _verdict(result, kept))
         if kept:
             ex, gates, policy, failed = result
-    if failed and set(failed) <= NORMAL_GATES and not tried_split:
-        split, added, declined = _split_toward_field(ex, rest_field)
-        if added:
-            kept, result = _judged(rig, split, gates, policy, failed, rest_field, skeleton, grid)
-            progress(
-                f"{added} edges split toward the field where the normals disagree ({declined} marked "
-                f"triangles declined: a midpoint there would not reach the zero set): "
-                + _verdict(result, kept)
-            )
-            if kept:
-                return result
+    if failed and set(failed) <= NORMAL_GATES and not only_normals:
+        return split(ex, 0) or (ex, gates, policy, failed)
     return ex, gates, policy, failed
 
 
-def _split_toward_field(ex: Extraction, rest_field: BodyField) -> tuple[Extraction, int, int]:
+def _split_toward_field(
+    ex: Extraction, rest_field: BodyField, marks: tuple[float, float] = (MARK_VERTEX_DEG, MARK_FACE_DEG)
+) -> tuple[Extraction, int, int]:
     """The extraction split locally toward the field (surface/subdivide.py), with its analytic normals and
     residual; returns (extraction, vertices added, marked faces declined)."""
-    mesh, added, declined = subdivide_to_field(ex.mesh, rest_field.field)
+    mesh, added, declined = subdivide_to_field(ex.mesh, rest_field.field, marks=marks)
     if added == 0:
         return ex, 0, declined
     normals = analytic_normals(mesh, rest_field.gradient)
@@ -650,8 +664,6 @@ def _split_toward_field(ex: Extraction, rest_field: BodyField) -> tuple[Extracti
 def _judged(
     rig: CompiledRig,
     candidate: Extraction,
-    gates: list[SurfaceGate],
-    policy: ComponentPolicy,
     failed: list[str],
     rest_field: BodyField,
     skeleton: Skeleton,

@@ -2844,7 +2844,7 @@ export const CREATURE = Object.freeze({
     0
   ],
   "signatures": {
-    "compilerSignature": "186a65a64d4df07591527d374c15ef17bed73f243b805ad32521c115a7c7ffb8",
+    "compilerSignature": "6e79676d7ff568f7d653773814b5f3ed0efc650cdb07b1188036fcd709ed9f47",
     "geometryDigest": "400b0d18a2a9f6bbbfe5b441f89767f552a4f3b4c45a368d1129d632e1d2f4f1",
     "topologySignature": "330d551e8c006f84b01459c84db69ca8c43aec5bc9d9083d3e85c291be5a68bf"
   },
