@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import json
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any
 
@@ -406,3 +406,30 @@ def test_a_joint_even_the_correction_cannot_carry_names_both_tries(
         deform.DeformationError, match=r"part\.lower.*tried with the seam corrected.*surface_max"
     ):
         chain.choose(corrector=_corrector(chain))
+
+
+def test_the_sweep_skins_its_seam_exactly_as_the_whole_mesh(biped: Body) -> None:
+    """correction_sweep skins only a seam and its one-ring (a 2 k-vertex seam on a 325 k-vertex body paid
+    for every vertex at every pose). Those rows must be the whole-mesh skin's, bit for bit, for every
+    method, and the ring must hold every corner of a face that touches the seam (``correct`` reads them)."""
+    from creaturegen.surface.build import _skin_near, seam
+
+    pair = (biped.indices, biped.weights)
+    choice = biped.choose()
+    pose = deform.pose_joint(biped.skeleton, biped.rig.slots, 1, 0, math.radians(50.0), math.radians(20.0))
+    on_seam = seam(biped.skeleton, pair, 1)
+    assert 0 < np.count_nonzero(on_seam) < biped.mesh.vertex_count // 2
+    for method in deform.METHODS:
+        methods = [method] * biped.rig.slot_count
+        every = deform.skin(
+            biped.mesh.vertices, biped.normals, *pair, pose, methods, biped.skeleton, choice.centers
+        )
+        near = _skin_near(
+            biped.mesh, biped.normals, pair, pose, replace(choice, methods=methods), biped.skeleton, on_seam
+        )
+        fans = biped.mesh.faces[on_seam[biped.mesh.faces].any(axis=1)].reshape(-1)
+        np.testing.assert_array_equal(near.positions[fans], every.positions[fans])
+        np.testing.assert_array_equal(near.normals[fans], every.normals[fans])
+        far = np.ones(biped.mesh.vertex_count, dtype=bool)
+        far[fans] = False
+        np.testing.assert_array_equal(near.positions[far], biped.mesh.vertices[far])

@@ -5,7 +5,8 @@ from __future__ import annotations
 import numpy as np
 
 from creaturegen.surface.build import EXTRA_REFINEMENTS, MAX_REFINEMENTS, SMALL_LATTICE_NODES, _may_refine
-from creaturegen.surface.grid import Grid
+from creaturegen.surface.grid import BLOCK, Grid
+from creaturegen.surface.sampling import _block_nodes
 
 
 def _grid(n: int) -> Grid:
@@ -100,3 +101,15 @@ def test_a_pointed_tip_starts_at_the_first_lattice_cap_and_refines_up_to_the_lim
     # A body whose target fits is not limited.
     slots[1, col.RB] = 0.02
     assert make_grid(slots, graph, "hero", ("body", "horn")).limited_by == ""
+
+
+def test_block_nodes_are_the_sorted_unique_nodes_of_the_blocks() -> None:
+    """sampling._block_nodes marks nodes instead of sorting them; shared block faces still count once and
+    the order is np.unique's (the sampled values are scattered back by these ids)."""
+    grid = Grid((0.0, 0.0, 0.0), 0.1, (3 * BLOCK + 1, 2 * BLOCK + 1, 4 * BLOCK + 1))
+    blocks = np.array([0, 1, 5, 6, 7, 23], dtype=np.int64)
+    offsets = np.stack(np.meshgrid(*([np.arange(BLOCK + 1)] * 3), indexing="ij"), axis=-1).reshape(-1, 3)
+    corner = np.stack(np.unravel_index(blocks, grid.blocks), axis=1) * BLOCK
+    nodes = (corner[:, None, :] + offsets[None, :, :]).reshape(-1, 3)
+    expected = np.unique(np.ravel_multi_index((nodes[:, 0], nodes[:, 1], nodes[:, 2]), grid.shape))
+    np.testing.assert_array_equal(_block_nodes(grid, blocks), expected)

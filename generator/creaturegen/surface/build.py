@@ -239,6 +239,37 @@ def vertex_trust(rig: CompiledRig, mesh: Mesh, normals: F64, indices: npt.NDArra
     return trust_radius(mesh, normals, np.maximum(rig.slots[owner, col.RA], rig.slots[owner, col.RB]))
 
 
+def _skin_near(
+    mesh: Mesh,
+    normals: F64,
+    weights: tuple[npt.NDArray[np.int32], F64],
+    pose: deform.Pose,
+    choice: deform.DeformationChoice,
+    skeleton: Skeleton,
+    on_seam: npt.NDArray[np.bool_],
+) -> deform.Skinned:
+    """The skin of the seam and its one-ring only, the rest left at rest: the sweep reads the seam's
+    positions and ``correct`` the fans of the vertices it moves, which lie within that ring. Skinning is
+    per vertex, so these rows are the very values a whole-mesh skin gives; a seam of 2 k vertices on a
+    325 k-vertex body paid for all of them at every pose (11.5 s of seed 96's 78 s)."""
+    ring = np.zeros(mesh.vertex_count, dtype=bool)
+    ring[mesh.faces[on_seam[mesh.faces].any(axis=1)].reshape(-1)] = True
+    rows = np.flatnonzero(ring | on_seam)
+    part = deform.skin(
+        mesh.vertices[rows],
+        normals[rows],
+        weights[0][rows],
+        weights[1][rows],
+        pose,
+        choice.methods,
+        skeleton,
+        choice.centers[rows],
+    )
+    positions, out_normals = mesh.vertices.copy(), normals.copy()
+    positions[rows], out_normals[rows] = part.positions, part.normals
+    return deform.Skinned(positions, out_normals, part.flips)
+
+
 def correction_sweep(
     rig: CompiledRig,
     mesh: Mesh,
@@ -281,9 +312,7 @@ def correction_sweep(
     for on_seam, pose in extremes:
         if not on_seam.any():
             continue
-        skinned = deform.skin(
-            mesh.vertices, normals, weights[0], weights[1], pose, choice.methods, skeleton, choice.centers
-        )
+        skinned = _skin_near(mesh, normals, weights, pose, choice, skeleton, on_seam)
         posed_field = BodyField(rig.graph, deform.posed_slots(rig.slots, pose))
         error = np.zeros(mesh.vertex_count)
         error[on_seam] = np.abs(posed_field.distance(skinned.positions[on_seam]))

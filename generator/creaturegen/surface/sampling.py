@@ -56,7 +56,11 @@ def _block_nodes(grid: Grid, blocks: npt.NDArray[np.int64]) -> npt.NDArray[np.in
     b = np.stack(np.unravel_index(blocks, (bx, by, bz)), axis=1) * BLOCK
     nodes = (b[:, None, :] + offsets[None, :, :]).reshape(-1, 3)
     flat = np.ravel_multi_index((nodes[:, 0], nodes[:, 1], nodes[:, 2]), grid.shape)
-    result: npt.NDArray[np.int64] = np.unique(flat)
+    # A mark per lattice node and its nonzero list: the sorted unique ids, as np.unique gives them, without
+    # sorting ~6 M ids (3 s a lattice on a 325 k-vertex body; the marks cost one byte per node).
+    marks = np.zeros(int(np.prod(grid.shape)), dtype=bool)
+    marks[flat] = True
+    result: npt.NDArray[np.int64] = np.flatnonzero(marks)
     return result
 
 

@@ -2844,7 +2844,7 @@ export const CREATURE = Object.freeze({
     0
   ],
   "signatures": {
-    "compilerSignature": "6e79676d7ff568f7d653773814b5f3ed0efc650cdb07b1188036fcd709ed9f47",
+    "compilerSignature": "46f7161d7a1d058bfee69cbbbc220124abd8d0c290cff55bf159f8112109f986",
     "geometryDigest": "400b0d18a2a9f6bbbfe5b441f89767f552a4f3b4c45a368d1129d632e1d2f4f1",
     "topologySignature": "330d551e8c006f84b01459c84db69ca8c43aec5bc9d9083d3e85c291be5a68bf"
   },
