@@ -16,6 +16,7 @@ import numpy as np
 import pytest
 
 from conftest import EXAMPLES, rest_surface
+from creaturegen.spec import CharacterSpec, load_spec
 from creaturegen.surface.field64 import BodyField
 from creaturegen.surface.mesh import Mesh
 from creaturegen.surface.skeleton import Skeleton, build_skeleton
@@ -233,3 +234,28 @@ def test_the_build_reads_still_joints_from_the_motion() -> None:
     still = {skeleton.names[c] for c in pose_envelope(spec, rig).still_joints(rig.body_scale)}
     assert {"part.head", "part.snout"} <= still
     assert not any(name.startswith(("part.leg", "part.tail")) for name in still)
+
+
+STEEP_ROPE = Path(__file__).parent / "fixtures" / "steep-rope-hopper.json"
+
+
+def test_a_steep_weight_rim_is_split_before_the_build_refuses(monkeypatch: pytest.MonkeyPatch) -> None:
+    """Generated seed 142 (`creaturegen random --seed 142`), a hopper whose 4-segment rope tail is about as
+    thick as a segment is long: tail[0]'s handle is a small island between the body's and tail[1]'s, and
+    the harmonic weight falls from 1 to 0.6 across one edge at its rim (0.4006 against the gate's 0.4).
+    The build splits the triangles along the steepest edges and keeps the split mesh, every gate passing;
+    without that remedy the same build is refused, naming the gate and the two tail segments."""
+    from creaturegen.rig import compile_rig
+    from creaturegen.surface import build as surface_build
+
+    spec = load_spec(STEEP_ROPE)
+    assert isinstance(spec, CharacterSpec)
+    said: list[str] = []
+    built = surface_build.build_surface(spec, compile_rig(spec), backend="numpy", progress=said.append)
+    assert [g.name for g in built.gates if not g.passed] == []
+    continuity = next(g for g in built.gates if g.name == "weights.continuity")
+    assert continuity.value < 0.4
+    assert any("split where a weight drops" in line for line in said), said
+    monkeypatch.setattr(surface_build, "WEIGHT_SPLIT_ROUNDS", 0)
+    with pytest.raises(surface_build.SurfaceRejectedError, match=r"weights\.continuity = 0\.40.*part\.tail"):
+        surface_build.build_surface(spec, compile_rig(spec), backend="numpy", progress=lambda _: None)

@@ -58,9 +58,16 @@ from .skin_tier import (
     skin_contract,
     skin_departures,
 )
-from .subdivide import MARK_FACE_DEG, MARK_VERTEX_DEG, TAIL_MARKS, analytic_normals, subdivide_to_field
+from .subdivide import (
+    MARK_FACE_DEG,
+    MARK_VERTEX_DEG,
+    TAIL_MARKS,
+    analytic_normals,
+    split_faces,
+    subdivide_to_field,
+)
 from .topology import components
-from .weights import SkinWeights, skin_weights
+from .weights import CONTINUITY_MAX, SkinWeights, motion_groups, skin_weights, steep_faces
 
 F64 = npt.NDArray[np.float64]
 Progress = Callable[[str], None]
@@ -95,6 +102,13 @@ MAX_REFINEMENTS = 2
 #: big one, and on a small lattice they cost little; a big body's refinements are the expensive ones.
 EXTRA_REFINEMENTS = 3
 SMALL_LATTICE_NODES = 2_000_000
+#: A contact between parts not joined in the skeleton whose field stays below this fraction of the finest
+#: allowed spacing along their closest line is a handle no lattice within the budget opens.
+UNRESOLVED_GAP_FRACTION = 0.5
+#: The weights.continuity remedy: rounds of splits, and the jump (as a fraction of the gate) that marks an
+#: edge's triangles for splitting. Below the gate, so the edges just under it are split with the worst.
+WEIGHT_SPLIT_ROUNDS = 3
+WEIGHT_SPLIT_MARK = 0.75
 #: Calibration points for picking the faster sampling backend.
 CALIBRATION_POINTS = 32768
 #: wgpu's start-up before its first sample (adapter, device, wgpu-native's cffi type parsing, the first
@@ -391,8 +405,14 @@ def _fail_on(gates: list[SurfaceGate], where: str, remedy: str = "") -> None:
         )
 
 
-def _mesh_remedy(refinement: int, spacing: float) -> str:
+def _mesh_remedy(refinement: int, spacing: float, certain: bool = False) -> str:
     """What the build tried for a mesh gate, and what the user can change (the gate names the place)."""
+    if certain:
+        return (
+            "; the field joins the parts named, or leaves them a gap narrower than half the finest lattice "
+            f"this build may sample resolves (refinement {refinement} at h = {spacing:.3g} m; no finer "
+            "lattice and no other remedy was tried, since none can open that handle)"
+        )
     return (
         f"; flipping edges, splitting triangles toward the field and refining the lattice did not help "
         f"(the best lattice tried, refinement {refinement} at "
@@ -491,11 +511,33 @@ def _may_refine(refinement: int, grid: Grid, tier: str = DEFAULT_TIER) -> bool:
     """Whether the lattice after ``grid`` (refinement + 1) is within the refinement budget. A lower tier's
     budget counts from the hero's first lattice: it may refine as far as the hero would, so a mesh gate
     the hero's lattices pass never refuses a lower tier for starting coarser."""
+    return _may_refine_nodes(refinement, float(np.prod(grid.shape)), tier)
+
+
+def _may_refine_nodes(refinement: int, nodes: float, tier: str) -> bool:
     base = MAX_REFINEMENTS + tier_offset(tier)
     if refinement < base:
         return True
-    nodes = 2.0**1.5 * float(np.prod(grid.shape))  # √2 finer along each axis
-    return refinement < base + EXTRA_REFINEMENTS and nodes <= SMALL_LATTICE_NODES
+    # √2 finer along each axis.
+    return refinement < base + EXTRA_REFINEMENTS and 2.0**1.5 * nodes <= SMALL_LATTICE_NODES
+
+
+def finest_spacing(refinement: int, grid: Grid, tier: str = DEFAULT_TIER) -> float:
+    """The spacing of the finest lattice the refinement budget still allows after ``grid``."""
+    spacing, nodes = grid.spacing, float(np.prod(grid.shape))
+    while _may_refine_nodes(refinement, nodes, tier):
+        refinement, nodes, spacing = refinement + 1, 2.0**1.5 * nodes, spacing / math.sqrt(2.0)
+    return spacing
+
+
+def _handles_stay(policy: ComponentPolicy, refinement: int, grid: Grid, tier: str) -> bool:
+    """Whether some contact closes a handle that every lattice the budget allows would show: the field
+    joins the two parts (ComponentPolicy.handles_certain), or leaves them a gap narrower than half the
+    finest spacing, which marching cubes bridges (a separating sheet of outside nodes would have to fall
+    inside it all along the contact). Seed 83's legs, 0.4 mm apart at most along their closest line, made
+    the same handles at h = 12, 8.5 and 6 mm and were refused after 93 s."""
+    half = UNRESOLVED_GAP_FRACTION * finest_spacing(refinement, grid, tier)
+    return policy.handles_certain or any(not c.joined and c.bridge < half for c in policy.handles)
 
 
 def _failed_count(attempt: ValidatedMesh) -> int:
@@ -526,8 +568,12 @@ def validated_mesh(
         failed = [g.name for g in attempt.gates if not g.passed]
         if not failed:
             break
-        if failed == ["euler"] and attempt.policy.handles_certain:
-            progress("the field itself closes these handles: a finer lattice cannot open them")
+        if "euler" in failed and _handles_stay(attempt.policy, refinement, attempt.grid, tier):
+            # Whatever else fails, this mesh is refused: no lattice within the budget opens these handles.
+            progress(
+                "the field closes these handles, or leaves a gap narrower than half the finest lattice "
+                "allowed: a finer lattice cannot open them"
+            )
             break
         if not _may_refine(refinement, attempt.grid, tier):
             break
@@ -584,11 +630,13 @@ def _one_lattice(
         f"mesh gates: {len(gates) - len(failed)}/{len(gates)} passed"
         + (f"; failed {failed}" if failed else "")
     )
-    refining = "euler" in failed and not policy.handles_certain and _may_refine(refinement, grid, tier)
-    if any(name in NORMAL_GATES for name in failed) and not refining:
-        # Not when the genus is wrong and a finer lattice follows anyway: neither remedy changes the
-        # topology, so it cannot spare that lattice, and re-gating a large mesh for it cost seed 88 nine
-        # seconds.
+    # Not when the genus is wrong: neither remedy changes the topology, so it cannot spare the finer
+    # lattice that follows (re-gating a large mesh for it cost seed 88 nine seconds), nor a refusal where
+    # the field itself closes the handle (every lattice fails euler there).
+    doomed = "euler" in failed and (
+        _may_refine(refinement, grid, tier) or _handles_stay(policy, refinement, grid, tier)
+    )
+    if any(name in NORMAL_GATES for name in failed) and not doomed:
         t = time.perf_counter()
         ex, gates, policy, failed = _remedied(
             rig, ex, gates, policy, failed, rest_field, skeleton, grid, progress
@@ -677,17 +725,73 @@ def _remedied(
     return ex, gates, policy, failed
 
 
+def _spread_steep_weights(
+    rig: CompiledRig,
+    current: Remedy,
+    weights: SkinWeights,
+    rest_field: BodyField,
+    skeleton: Skeleton,
+    grid: Grid,
+    still: frozenset[int],
+    progress: Progress,
+) -> tuple[Extraction, list[SurfaceGate], ComponentPolicy, SkinWeights]:
+    """The remedy for weights.continuity: split the triangles along whose edges a motion group's weight
+    drops steeply (the rim of a small handle island, a short rope segment between two longer ones), so the
+    transition spans more edges. The handles are placed by distances (HANDLE_GAP · r), not by edges, so
+    the harmonic weights keep their shape and each split edge carries about half the jump. The split mesh
+    is kept only when every mesh gate still passes and the jump falls; up to WEIGHT_SPLIT_ROUNDS rounds."""
+    groups = motion_groups(skeleton, still)
+    before = weights.gate("weights.continuity").value
+    for _ in range(WEIGHT_SPLIT_ROUNDS):
+        ex = current[0]
+        steep = steep_faces(ex.mesh, weights, groups, WEIGHT_SPLIT_MARK * CONTINUITY_MAX)
+        candidate, added, declined = _split_faces(ex, rest_field, steep)
+        if not added:
+            break
+        kept, result = _judged(rig, candidate, [], rest_field, skeleton, grid)
+        again = skin_weights(candidate.mesh, rest_field, skeleton, still=still) if kept else weights
+        value = again.gate("weights.continuity").value
+        progress(
+            f"weights.continuity {weights.gate('weights.continuity').value:.3g}: {added} edges split where a "
+            f"weight drops by over {WEIGHT_SPLIT_MARK * CONTINUITY_MAX:.2g} per edge ({declined} declined): "
+            + (f"{value:.3g}" if kept else _verdict(result, kept))
+        )
+        if not kept or value >= weights.gate("weights.continuity").value:
+            break
+        current, weights = result, again
+        if weights.gate("weights.continuity").passed:
+            break
+    if weights.gate("weights.continuity").value < before:
+        progress(f"kept the split mesh: {current[0].mesh.vertex_count:,} vertices")
+    return current[0], current[1], current[2], weights
+
+
+def _split_faces(
+    ex: Extraction, rest_field: BodyField, faces: npt.NDArray[np.int64]
+) -> tuple[Extraction, int, int]:
+    """``ex`` with the longest edge of each of ``faces`` split onto the zero set (surface/subdivide.py)."""
+    mesh, added, declined = split_faces(ex.mesh, faces, rest_field.field)
+    return _with_split(ex, rest_field, mesh, added, declined)
+
+
+def _with_split(
+    ex: Extraction, rest_field: BodyField, mesh: Mesh, added: int, declined: int
+) -> tuple[Extraction, int, int]:
+    """A split mesh as an extraction: analytic normals, and the residual of the new vertices."""
+    if added == 0:
+        return ex, 0, declined
+    normals = analytic_normals(mesh, rest_field.gradient)
+    residual = float(np.max(np.abs(rest_field.distance(mesh.vertices[ex.mesh.vertex_count :]))))
+    return replace(ex, mesh=mesh, normals=normals, residual=max(ex.residual, residual)), added, declined
+
+
 def _split_toward_field(
     ex: Extraction, rest_field: BodyField, marks: tuple[float, float] = (MARK_VERTEX_DEG, MARK_FACE_DEG)
 ) -> tuple[Extraction, int, int]:
     """The extraction split locally toward the field (surface/subdivide.py), with its analytic normals and
     residual; returns (extraction, vertices added, marked faces declined)."""
     mesh, added, declined = subdivide_to_field(ex.mesh, rest_field.field, marks=marks)
-    if added == 0:
-        return ex, 0, declined
-    normals = analytic_normals(mesh, rest_field.gradient)
-    residual = float(np.max(np.abs(rest_field.distance(mesh.vertices[ex.mesh.vertex_count :]))))
-    return replace(ex, mesh=mesh, normals=normals, residual=max(ex.residual, residual)), added, declined
+    return _with_split(ex, rest_field, mesh, added, declined)
 
 
 def _judged(
@@ -800,10 +904,19 @@ def _extract_with(
     if policy.detached:
         progress(f"declared: {', '.join(policy.detached)} detached from the body (the field leaves a gap)")
     if strict:
-        _fail_on(gates, f"surface {tier}", _mesh_remedy(refinement, grid.spacing))
+        certain = any(g.name == "euler" and not g.passed for g in gates) and _handles_stay(
+            policy, refinement, grid, tier
+        )
+        _fail_on(gates, f"surface {tier}", _mesh_remedy(refinement, grid.spacing, certain))
 
     t = time.perf_counter()
-    weights = skin_weights(mesh, rest_field, skeleton, still=envelope.still_joints(rig.body_scale))
+    still = envelope.still_joints(rig.body_scale)
+    weights = skin_weights(mesh, rest_field, skeleton, still=still)
+    if not weights.gate("weights.continuity").passed and not [g for g in gates if not g.passed]:
+        ex, gates, policy, weights = _spread_steep_weights(
+            rig, (ex, gates, policy, []), weights, rest_field, skeleton, grid, still, progress
+        )
+        mesh = ex.mesh
     gates += list(weights.gates)
     timings["weights"] = time.perf_counter() - t
     progress(f"skin weights: {weights.barrier_edges} barrier edges, {timings['weights']:.2f} s")

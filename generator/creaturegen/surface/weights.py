@@ -403,10 +403,7 @@ def _gates(
     worst = int(np.argmax(leak)) if v_count else 0
     dense = np.zeros((v_count, s_count))
     np.add.at(dense, (np.arange(v_count)[:, None], indices), weights)
-    membership = np.zeros((s_count, int(groups.max(initial=0)) + 1))
-    membership[np.arange(s_count), groups] = 1.0
-    grouped = dense @ membership
-    jump = np.abs(grouped[edges[:, 0]] - grouped[edges[:, 1]]).max(axis=1, initial=0.0)
+    jump = group_jumps(dense, groups, edges)
     slot_jump = np.abs(dense[edges[:, 0]] - dense[edges[:, 1]]).max(axis=1, initial=0.0)
     outside = ~contact[edges[:, 0]] & ~contact[edges[:, 1]]
     smooth = jump[outside] if outside.any() else np.zeros(1)
@@ -455,6 +452,27 @@ def _gates(
             detail="; ".join(x for x in coverage if x),
         ),
     )
+
+
+def group_jumps(dense: F64, groups: I32, edges: I64) -> F64:
+    """Per edge, the largest change of one motion group's summed weight along it (what the continuity
+    gate reads)."""
+    membership = np.zeros((dense.shape[1], int(groups.max(initial=0)) + 1))
+    membership[np.arange(dense.shape[1]), groups] = 1.0
+    grouped = dense @ membership
+    result: F64 = np.abs(grouped[edges[:, 0]] - grouped[edges[:, 1]]).max(axis=1, initial=0.0)
+    return result
+
+
+def steep_faces(mesh: Mesh, weights: SkinWeights, groups: I32, mark: float) -> I64:
+    """Faces with an edge outside the contact zones along which a motion group's weight changes by more
+    than ``mark``: where splitting the mesh spreads a steep transition over more edges."""
+    edges = mesh.edges().astype(np.int64)
+    jump = group_jumps(weights.dense(len(groups)), groups, edges)
+    outside = ~weights.contact[edges[:, 0]] & ~weights.contact[edges[:, 1]]
+    steep = (jump > mark) & outside
+    result: I64 = np.unique(np.flatnonzero(steep) // 3)
+    return result
 
 
 def _edge_slots(edge: I64, dense: F64, skeleton: Skeleton) -> str:
