@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import numpy as np
-import pytest
 
 from creaturegen.surface.build import EXTRA_REFINEMENTS, MAX_REFINEMENTS, SMALL_LATTICE_NODES, _may_refine
 from creaturegen.surface.grid import BLOCK, Grid
@@ -114,36 +113,3 @@ def test_block_nodes_are_the_sorted_unique_nodes_of_the_blocks() -> None:
     nodes = (corner[:, None, :] + offsets[None, :, :]).reshape(-1, 3)
     expected = np.unique(np.ravel_multi_index((nodes[:, 0], nodes[:, 1], nodes[:, 2]), grid.shape))
     np.testing.assert_array_equal(_block_nodes(grid, blocks), expected)
-
-
-def test_the_finest_spacing_is_where_the_budget_stops() -> None:
-    """A big lattice halves its spacing once (two √2 steps); a small one goes on while it stays small."""
-    from creaturegen.surface.build import finest_spacing
-
-    big = _grid(300)
-    assert finest_spacing(0, big) == pytest.approx(big.spacing / 2.0, rel=1e-12)
-    assert finest_spacing(MAX_REFINEMENTS, big) == big.spacing
-    small = _grid(49)
-    assert finest_spacing(0, small) < big.spacing / 2.0
-
-
-def test_a_handle_narrower_than_the_finest_lattice_stops_the_refinement() -> None:
-    """Two parts the skeleton does not join, whose field stays within a few tenths of a millimetre of zero
-    along their closest line, close a handle every affordable lattice shows (generated seed 83: the same
-    three handles at h = 12, 8.5 and 6 mm, refused after 93 s). A gap wider than half the finest spacing
-    may still open, and a joined pair (a joint) never stops the search this way."""
-    from creaturegen.surface.build import _handles_stay, finest_spacing
-    from creaturegen.surface.components import ComponentPolicy
-    from creaturegen.surface.handles import Contact
-
-    grid = _grid(300)
-    half = 0.5 * finest_spacing(0, grid)
-
-    def policy(bridge: float, joined: bool = False) -> ComponentPolicy:
-        contact = Contact("part.leg-a", "part.leg-b", 1.0, joined, 0.02, bridge)
-        return ComponentPolicy(1, (0,), (), (), (), (), (contact,))
-
-    assert _handles_stay(policy(-1e-4), 0, grid, "hero")  # the field joins them: certain
-    assert _handles_stay(policy(0.9 * half), 0, grid, "hero")
-    assert not _handles_stay(policy(1.1 * half), 0, grid, "hero")
-    assert not _handles_stay(policy(0.9 * half, joined=True), 0, grid, "hero")

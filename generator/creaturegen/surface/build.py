@@ -102,9 +102,6 @@ MAX_REFINEMENTS = 2
 #: big one, and on a small lattice they cost little; a big body's refinements are the expensive ones.
 EXTRA_REFINEMENTS = 3
 SMALL_LATTICE_NODES = 2_000_000
-#: A contact between parts not joined in the skeleton whose field stays below this fraction of the finest
-#: allowed spacing along their closest line is a handle no lattice within the budget opens.
-UNRESOLVED_GAP_FRACTION = 0.5
 #: The weights.continuity remedy: rounds of splits, and the jump (as a fraction of the gate) that marks an
 #: edge's triangles for splitting. Below the gate, so the edges just under it are split with the worst.
 WEIGHT_SPLIT_ROUNDS = 3
@@ -405,14 +402,8 @@ def _fail_on(gates: list[SurfaceGate], where: str, remedy: str = "") -> None:
         )
 
 
-def _mesh_remedy(refinement: int, spacing: float, certain: bool = False) -> str:
+def _mesh_remedy(refinement: int, spacing: float) -> str:
     """What the build tried for a mesh gate, and what the user can change (the gate names the place)."""
-    if certain:
-        return (
-            "; the field joins the parts named, or leaves them a gap narrower than half the finest lattice "
-            f"this build may sample resolves (refinement {refinement} at h = {spacing:.3g} m; no finer "
-            "lattice and no other remedy was tried, since none can open that handle)"
-        )
     return (
         f"; flipping edges, splitting triangles toward the field and refining the lattice did not help "
         f"(the best lattice tried, refinement {refinement} at "
@@ -511,33 +502,11 @@ def _may_refine(refinement: int, grid: Grid, tier: str = DEFAULT_TIER) -> bool:
     """Whether the lattice after ``grid`` (refinement + 1) is within the refinement budget. A lower tier's
     budget counts from the hero's first lattice: it may refine as far as the hero would, so a mesh gate
     the hero's lattices pass never refuses a lower tier for starting coarser."""
-    return _may_refine_nodes(refinement, float(np.prod(grid.shape)), tier)
-
-
-def _may_refine_nodes(refinement: int, nodes: float, tier: str) -> bool:
     base = MAX_REFINEMENTS + tier_offset(tier)
     if refinement < base:
         return True
-    # √2 finer along each axis.
-    return refinement < base + EXTRA_REFINEMENTS and 2.0**1.5 * nodes <= SMALL_LATTICE_NODES
-
-
-def finest_spacing(refinement: int, grid: Grid, tier: str = DEFAULT_TIER) -> float:
-    """The spacing of the finest lattice the refinement budget still allows after ``grid``."""
-    spacing, nodes = grid.spacing, float(np.prod(grid.shape))
-    while _may_refine_nodes(refinement, nodes, tier):
-        refinement, nodes, spacing = refinement + 1, 2.0**1.5 * nodes, spacing / math.sqrt(2.0)
-    return spacing
-
-
-def _handles_stay(policy: ComponentPolicy, refinement: int, grid: Grid, tier: str) -> bool:
-    """Whether some contact closes a handle that every lattice the budget allows would show: the field
-    joins the two parts (ComponentPolicy.handles_certain), or leaves them a gap narrower than half the
-    finest spacing, which marching cubes bridges (a separating sheet of outside nodes would have to fall
-    inside it all along the contact). Seed 83's legs, 0.4 mm apart at most along their closest line, made
-    the same handles at h = 12, 8.5 and 6 mm and were refused after 93 s."""
-    half = UNRESOLVED_GAP_FRACTION * finest_spacing(refinement, grid, tier)
-    return policy.handles_certain or any(not c.joined and c.bridge < half for c in policy.handles)
+    nodes = 2.0**1.5 * float(np.prod(grid.shape))  # √2 finer along each axis
+    return refinement < base + EXTRA_REFINEMENTS and nodes <= SMALL_LATTICE_NODES
 
 
 def _failed_count(attempt: ValidatedMesh) -> int:
@@ -568,12 +537,8 @@ def validated_mesh(
         failed = [g.name for g in attempt.gates if not g.passed]
         if not failed:
             break
-        if "euler" in failed and _handles_stay(attempt.policy, refinement, attempt.grid, tier):
-            # Whatever else fails, this mesh is refused: no lattice within the budget opens these handles.
-            progress(
-                "the field closes these handles, or leaves a gap narrower than half the finest lattice "
-                "allowed: a finer lattice cannot open them"
-            )
+        if failed == ["euler"] and attempt.policy.handles_certain:
+            progress("the field itself closes these handles: a finer lattice cannot open them")
             break
         if not _may_refine(refinement, attempt.grid, tier):
             break
@@ -630,13 +595,11 @@ def _one_lattice(
         f"mesh gates: {len(gates) - len(failed)}/{len(gates)} passed"
         + (f"; failed {failed}" if failed else "")
     )
-    # Not when the genus is wrong: neither remedy changes the topology, so it cannot spare the finer
-    # lattice that follows (re-gating a large mesh for it cost seed 88 nine seconds), nor a refusal where
-    # the field itself closes the handle (every lattice fails euler there).
-    doomed = "euler" in failed and (
-        _may_refine(refinement, grid, tier) or _handles_stay(policy, refinement, grid, tier)
-    )
-    if any(name in NORMAL_GATES for name in failed) and not doomed:
+    refining = "euler" in failed and not policy.handles_certain and _may_refine(refinement, grid, tier)
+    if any(name in NORMAL_GATES for name in failed) and not refining:
+        # Not when the genus is wrong and a finer lattice follows anyway: neither remedy changes the
+        # topology, so it cannot spare that lattice, and re-gating a large mesh for it cost seed 88 nine
+        # seconds.
         t = time.perf_counter()
         ex, gates, policy, failed = _remedied(
             rig, ex, gates, policy, failed, rest_field, skeleton, grid, progress
@@ -904,10 +867,7 @@ def _extract_with(
     if policy.detached:
         progress(f"declared: {', '.join(policy.detached)} detached from the body (the field leaves a gap)")
     if strict:
-        certain = any(g.name == "euler" and not g.passed for g in gates) and _handles_stay(
-            policy, refinement, grid, tier
-        )
-        _fail_on(gates, f"surface {tier}", _mesh_remedy(refinement, grid.spacing, certain))
+        _fail_on(gates, f"surface {tier}", _mesh_remedy(refinement, grid.spacing))
 
     t = time.perf_counter()
     still = envelope.still_joints(rig.body_scale)
