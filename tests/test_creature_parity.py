@@ -337,6 +337,33 @@ def test_the_job_catches_a_spawn_that_creates_a_buffer(out_root: Path, tmp_path:
 
 
 @pytest.mark.browser
+def test_the_job_catches_a_spawn_that_creates_a_pipeline(out_root: Path, tmp_path: Path) -> None:
+    """No spawn compiles anything: every pipeline exists before the reveal. A spawn that builds a compute
+    pipeline (a per-body kernel, say) fails the pipeline counter gate, which counts the device's calls."""
+    package = build("reference/hopper.json", out_root)
+    planted = _planted(
+        package,
+        tmp_path,
+        "population.js",
+        [
+            (
+                "    spawn({ seed = 0, position = [0, 0, 0] } = {}) {",
+                "    spawn({ seed = 0, position = [0, 0, 0] } = {}) {\n"
+                "      { const device = renderer.backend.device;\n"
+                "        const code = '@compute @workgroup_size(1) fn main() {}';\n"
+                "        const module = device.createShaderModule({ code });\n"
+                "        const compute = { module, entryPoint: 'main' };\n"
+                "        device.createComputePipeline({ layout: 'auto', compute }); }",
+            )
+        ],
+    )
+    report = run_creature_parity(planted, groups=("population",))
+    failed = {g["name"] for g in report.gates if g["status"] == "fail"}
+    assert f"pipelines created by {SPAWNS} spawns after reveal" in failed, report.summary()
+    assert f"buffers created by {SPAWNS} spawns after reveal" not in failed, report.summary()
+
+
+@pytest.mark.browser
 def test_the_job_catches_a_spawn_that_spreads_bodies_over_pages(out_root: Path, tmp_path: Path) -> None:
     """Each page is one draw per pass: a spawn that deals bodies round-robin over the pages instead of
     filling the first free slot uses every page for nine bodies, and the pages-in-use gate fails."""
