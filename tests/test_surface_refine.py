@@ -21,8 +21,8 @@ def test_extra_refinements_only_while_the_lattice_is_small() -> None:
     small = _grid(49)  # 49³ = 117,649 nodes
     assert _may_refine(MAX_REFINEMENTS, small)
     assert not _may_refine(MAX_REFINEMENTS + EXTRA_REFINEMENTS, small)
-    big = _grid(121)  # 1.77 M nodes, 5.0 M after a √2 refinement
-    assert SMALL_LATTICE_NODES < 2.0**1.5 * 121**3
+    big = _grid(150)  # 3.4 M nodes, 9.5 M after a √2 refinement
+    assert SMALL_LATTICE_NODES < 2.0**1.5 * 150**3
     assert not _may_refine(MAX_REFINEMENTS, big)
 
 
@@ -40,7 +40,7 @@ def test_a_lower_tier_may_refine_as_far_as_the_hero_would() -> None:
     assert isinstance(spec, CharacterSpec)
     slots = compile_rig(spec).slots
 
-    big = _grid(121)
+    big = _grid(150)
     assert [tier_offset(t) for t in ("hero", "repeated", "distant")] == [0, 1, 2]
     assert not _may_refine(MAX_REFINEMENTS, big, "hero")
     assert _may_refine(MAX_REFINEMENTS, big, "repeated")

@@ -2844,7 +2844,7 @@ export const CREATURE = Object.freeze({
     0
   ],
   "signatures": {
-    "compilerSignature": "2c78a96ac64d994c73c84362561cf96fbeacb1e2f6a84dd74d7e64ce7ad32703",
+    "compilerSignature": "c724bb806a0332c6809bb663eadb01381d0bcf0939951d4897f38dc9aea6e553",
     "geometryDigest": "400b0d18a2a9f6bbbfe5b441f89767f552a4f3b4c45a368d1129d632e1d2f4f1",
     "topologySignature": "330d551e8c006f84b01459c84db69ca8c43aec5bc9d9083d3e85c291be5a68bf"
   },
