@@ -315,52 +315,34 @@ def test_the_job_catches_a_wrong_display_transform(
     assert gate in failed, f"{planted_defect}: {report.summary()}"
 
 
-@pytest.mark.browser
-def test_the_job_catches_a_spawn_that_creates_a_buffer(out_root: Path, tmp_path: Path) -> None:
-    """Spawning is an O(slots) write into existing storage: a spawn that allocates fails the counter gate."""
-    package = build("reference/hopper.json", out_root)
-    planted = _planted(
-        package,
-        tmp_path,
-        "population.js",
-        [
-            (
-                "    spawn({ seed = 0, position = [0, 0, 0] } = {}) {",
-                "    spawn({ seed = 0, position = [0, 0, 0] } = {}) {\n"
-                "      renderer.backend.device.createBuffer({ size: 16, usage: 0x0040 }).destroy();",
-            )
-        ],
-    )
-    report = run_creature_parity(planted, groups=("population",))
-    failed = {g["name"] for g in report.gates if g["status"] == "fail"}
-    assert f"buffers created by {SPAWNS} spawns after reveal" in failed, report.summary()
+#: Code a planted spawn runs first, and the counter gate it must trip (the other must stay quiet).
+_SPAWN_ALLOCATIONS = {
+    "buffer": "      renderer.backend.device.createBuffer({ size: 16, usage: 0x0040 }).destroy();",
+    "pipeline": (
+        "      { const device = renderer.backend.device;\n"
+        "        const code = '@compute @workgroup_size(1) fn main() {}';\n"
+        "        const module = device.createShaderModule({ code });\n"
+        "        const compute = { module, entryPoint: 'main' };\n"
+        "        device.createComputePipeline({ layout: 'auto', compute }); }"
+    ),
+}
 
 
 @pytest.mark.browser
-def test_the_job_catches_a_spawn_that_creates_a_pipeline(out_root: Path, tmp_path: Path) -> None:
-    """No spawn compiles anything: every pipeline exists before the reveal. A spawn that builds a compute
-    pipeline (a per-body kernel, say) fails the pipeline counter gate, which counts the device's calls."""
+@pytest.mark.parametrize(("kind", "other"), [("buffer", "pipeline"), ("pipeline", "buffer")])
+def test_the_job_catches_a_spawn_that_allocates(
+    out_root: Path, tmp_path: Path, kind: str, other: str
+) -> None:
+    """Spawning is an O(slots) write into existing storage, and every pipeline exists before the reveal: a
+    spawn that creates a buffer, or compiles a pipeline (a per-body kernel, say), fails its counter gate,
+    which counts the device's own calls, and only that one."""
     package = build("reference/hopper.json", out_root)
-    planted = _planted(
-        package,
-        tmp_path,
-        "population.js",
-        [
-            (
-                "    spawn({ seed = 0, position = [0, 0, 0] } = {}) {",
-                "    spawn({ seed = 0, position = [0, 0, 0] } = {}) {\n"
-                "      { const device = renderer.backend.device;\n"
-                "        const code = '@compute @workgroup_size(1) fn main() {}';\n"
-                "        const module = device.createShaderModule({ code });\n"
-                "        const compute = { module, entryPoint: 'main' };\n"
-                "        device.createComputePipeline({ layout: 'auto', compute }); }",
-            )
-        ],
-    )
+    head = "    spawn({ seed = 0, position = [0, 0, 0] } = {}) {"
+    planted = _planted(package, tmp_path, "population.js", [(head, f"{head}\n{_SPAWN_ALLOCATIONS[kind]}")])
     report = run_creature_parity(planted, groups=("population",))
     failed = {g["name"] for g in report.gates if g["status"] == "fail"}
-    assert f"pipelines created by {SPAWNS} spawns after reveal" in failed, report.summary()
-    assert f"buffers created by {SPAWNS} spawns after reveal" not in failed, report.summary()
+    assert f"{kind}s created by {SPAWNS} spawns after reveal" in failed, report.summary()
+    assert f"{other}s created by {SPAWNS} spawns after reveal" not in failed, report.summary()
 
 
 @pytest.mark.browser

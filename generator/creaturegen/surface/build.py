@@ -715,13 +715,15 @@ def _spread_steep_weights(
             break
         kept, result = _judged(rig, candidate, [], rest_field, skeleton, grid)
         again = skin_weights(candidate.mesh, rest_field, skeleton, still=still) if kept else weights
-        value = again.gate("weights.continuity").value
+        now, value = weights.gate("weights.continuity").value, again.gate("weights.continuity").value
         progress(
-            f"weights.continuity {weights.gate('weights.continuity').value:.3g}: {added} edges split where a "
-            f"weight drops by over {WEIGHT_SPLIT_MARK * CONTINUITY_MAX:.2g} per edge ({declined} declined): "
+            f"weights.continuity {now:.3g}: {added} edges split where a weight drops by over "
+            f"{WEIGHT_SPLIT_MARK * CONTINUITY_MAX:.2g} per edge ({declined} declined): "
             + (f"{value:.3g}" if kept else _verdict(result, kept))
         )
-        if not kept or value >= weights.gate("weights.continuity").value:
+        # Kept only when the jump falls and no other weight gate starts failing.
+        newly = _failing(again) - _failing(weights)
+        if not kept or value >= now or newly:
             break
         current, weights = result, again
         if weights.gate("weights.continuity").passed:
@@ -729,6 +731,10 @@ def _spread_steep_weights(
     if weights.gate("weights.continuity").value < before:
         progress(f"kept the split mesh: {current[0].mesh.vertex_count:,} vertices")
     return current[0], current[1], current[2], weights
+
+
+def _failing(weights: SkinWeights) -> set[str]:
+    return {g.name for g in weights.gates if not g.passed}
 
 
 def _split_faces(
