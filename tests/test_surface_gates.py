@@ -16,7 +16,7 @@ import pytest
 from skimage.measure import marching_cubes
 
 from creaturegen.surface import intersect, topology
-from creaturegen.surface.gates import SurfaceGate, mesh_gates, zero_set_to_mesh
+from creaturegen.surface.gates import SurfaceGate, mesh_gates, normal_gates, zero_set_to_mesh
 from creaturegen.surface.mesh import Mesh
 
 F64 = npt.NDArray[np.float64]
@@ -381,6 +381,46 @@ def test_a_fused_field_changes_no_gate(sphere: Mesh) -> None:
         sphere, length_scale=L, distance=sphere_distance, gradient=sphere_gradient, field=field
     )
     assert [(g.as_dict(), g.where) for g in fused] == [(g.as_dict(), g.where) for g in plain]
+
+
+@pytest.mark.parametrize("bumpy", [False, True])
+def test_the_normal_gates_alone_equal_a_full_pass(sphere: Mesh, bumpy: bool) -> None:
+    """``normal_gates`` lets a remedy be turned down before a full pass (build._judged): its four gates
+    must be the full pass's, value for value and place for place, failing or not."""
+
+    def field(p: F64) -> tuple[F64, F64]:
+        return sphere_distance(p), sphere_gradient(p)
+
+    mesh = sphere
+    if bumpy:
+        sign = np.where(np.arange(sphere.vertex_count) % 2 == 0, 1.0, -1.0)
+        mesh = Mesh(
+            sphere.vertices + (0.002 * L * sign)[:, None] * sphere_gradient(sphere.vertices), sphere.faces
+        )
+    limits = (15.0, 5.0, 30.0, 10.0)
+    full = mesh_gates(
+        mesh,
+        length_scale=L,
+        distance=sphere_distance,
+        gradient=sphere_gradient,
+        field=field,
+        vertex_normal_max_deg=limits[0],
+        vertex_normal_p99_deg=limits[1],
+        face_normal_max_deg=limits[2],
+        face_normal_p99_deg=limits[3],
+    )
+    alone = normal_gates(mesh, length_scale=L, field=field, normal_limits=limits)
+    assert [g.name for g in alone] == [
+        "vertexNormalAngleMax",
+        "vertexNormalAngleP99",
+        "faceNormalAngleMax",
+        "faceNormalAngleP99",
+    ]
+    by_name = {g.name: g for g in full}
+    assert [(g.as_dict(), g.where) for g in alone] == [
+        (by_name[g.name].as_dict(), by_name[g.name].where) for g in alone
+    ]
+    assert any(not g.passed for g in alone) == bumpy
 
 
 # ------------------------------------------------------------------------------- exact predicates

@@ -20,7 +20,16 @@ from creaturegen.field import layout as col
 from creaturegen.rig import compile_rig
 from creaturegen.spec import CharacterSpec, load_spec
 from creaturegen.surface.build import SurfaceRejectedError, build_surface
-from creaturegen.surface.handles import Contact, _pieces, handle_contacts, primitive_gap, surface_genus
+from creaturegen.surface.handles import (
+    Contact,
+    _pieces,
+    certain_handle_possible,
+    cut_genus,
+    handle_contacts,
+    primitive_gap,
+    surface_genus,
+    uncut,
+)
 from creaturegen.surface.mesh import Mesh
 from creaturegen.surface.skeleton import build_skeleton
 
@@ -151,3 +160,54 @@ def test_a_joined_pair_touching_again_is_a_culprit() -> None:
     apart = Contact("part.leg-a", "part.leg-b", 1.0, False, 0.02, 0.01)
     assert apart.culprit
     assert "give one a k (or kCap) below 0.02 m" in apart.describe()
+
+
+#: Generated seed 4 (`creaturegen random --seed 4`): at the distant tier its first three lattices close a
+#: handle that no pair of unjoined parts makes certain, and the fourth opens it.
+UNTIL_FINE = FIXTURES / "genus-until-fine-quadruped.json"
+
+
+@pytest.mark.parametrize(
+    ("path", "tier", "expected"),
+    [
+        (TANGLED, "repeated", True),
+        (UNTIL_FINE, "distant", False),
+        (REPO / "examples" / "beetle.json", "repeated", False),
+    ],
+)
+def test_the_quick_certainty_check_agrees_with_the_contacts(path: Path, tier: str, expected: bool) -> None:
+    """``certain_handle_possible`` lets the build refine a lattice without its contacts; it must answer
+    exactly what the contacts would (a wrong False would refine past a refusal's stop rule, a wrong True
+    only costs time)."""
+    s = rest_surface(path, tier)
+    mesh, field, rig = s.extraction.mesh, s.field, s.rig
+    skeleton = build_skeleton(s.spec, rig)
+    distances = field.slot_distances(mesh.vertices)
+    quick = certain_handle_possible(mesh, distances, field.distance, skeleton, rig.slots, rig.slot_parts)
+    _, found = _contacts(path, tier)
+    assert quick == any(c.certain for c in found) == expected
+    if path == UNTIL_FINE:
+        assert surface_genus(mesh) >= 1.0, "the fixture no longer closes a handle at its first lattice"
+        assert found
+
+
+def test_a_cut_genus_from_the_whole_mesh_tables_equals_the_cut_mesh_genus() -> None:
+    """``cut_genus`` recounts only what a cut changes; on cuts of every kind (a contact strip, a scatter
+    of single faces that leaves pinch vertices, most of the mesh, a ring across the torus) it must equal
+    ``surface_genus`` of the cut mesh built anew."""
+    s = rest_surface(TANGLED, "repeated")
+    rng = np.random.default_rng(7)
+    for mesh in (_torus(), s.extraction.mesh):
+        base = uncut(mesh)
+        centroid = mesh.corners().mean(axis=1)
+        size = float(np.ptp(mesh.vertices, axis=0).max())
+        cuts = [np.zeros(mesh.face_count, dtype=bool)]
+        cuts += [rng.random(mesh.face_count) < p for p in (0.002, 0.05, 0.5, 0.97)]
+        for _ in range(6):
+            centre = centroid[rng.integers(mesh.face_count)]
+            r = rng.uniform(0.02, 0.3) * size
+            cuts.append(np.linalg.norm(centroid - centre, axis=1) < r)
+            cuts.append(np.abs(centroid[:, 0] - centre[0]) < 0.05 * r)
+        values = [cut_genus(base, cut) for cut in cuts]
+        assert values == [surface_genus(Mesh(mesh.vertices, mesh.faces[~cut])) for cut in cuts]
+        assert len(set(values)) > 1

@@ -2,11 +2,29 @@
 
 from __future__ import annotations
 
-import numpy as np
+from pathlib import Path
 
-from creaturegen.surface.build import EXTRA_REFINEMENTS, MAX_REFINEMENTS, SMALL_LATTICE_NODES, _may_refine
+import numpy as np
+import pytest
+
+from creaturegen.rig import compile_rig
+from creaturegen.spec import CharacterSpec, load_spec
+from creaturegen.surface import build
+from creaturegen.surface.backends import NumpyBackend
+from creaturegen.surface.build import (
+    EXTRA_REFINEMENTS,
+    MAX_REFINEMENTS,
+    SMALL_LATTICE_NODES,
+    ValidatedMesh,
+    _may_refine,
+    validated_mesh,
+)
 from creaturegen.surface.grid import BLOCK, Grid
 from creaturegen.surface.sampling import _block_nodes
+from creaturegen.surface.skeleton import build_skeleton
+
+#: Generated seed 4: a handle at its first three distant lattices that no unjoined pair makes certain.
+UNTIL_FINE = Path(__file__).parent / "fixtures" / "genus-until-fine-quadruped.json"
 
 
 def _grid(n: int) -> Grid:
@@ -113,3 +131,72 @@ def test_block_nodes_are_the_sorted_unique_nodes_of_the_blocks() -> None:
     nodes = (corner[:, None, :] + offsets[None, :, :]).reshape(-1, 3)
     expected = np.unique(np.ravel_multi_index((nodes[:, 0], nodes[:, 1], nodes[:, 2]), grid.shape))
     np.testing.assert_array_equal(_block_nodes(grid, blocks), expected)
+
+
+def _validated(path: Path, tier: str, said: list[str]) -> ValidatedMesh:
+    spec = load_spec(path)
+    assert isinstance(spec, CharacterSpec)
+    rig = compile_rig(spec)
+    backend = NumpyBackend(rig.graph, rig.slots)
+    return validated_mesh(rig, build_skeleton(spec, rig), tier, backend, "test", said.append)
+
+
+def test_a_lattice_refined_for_its_genus_changes_no_result(monkeypatch: pytest.MonkeyPatch) -> None:
+    """A lattice whose genus is wrong with no certain handle is refined without its other gates
+    (build._deferred). The generated quadruped closes a handle at its first three distant lattices: the
+    build must end where judging every lattice in full ends, with the same mesh and gate values."""
+    said: list[str] = []
+    quick = _validated(UNTIL_FINE, "distant", said)
+    waited = [line for line in said if "the other gates wait" in line]
+    assert len(waited) == 3, said
+    monkeypatch.setattr(build, "_deferred", lambda *args: None)
+    full: list[str] = []
+    eager = _validated(UNTIL_FINE, "distant", full)
+    assert not any("the other gates wait" in line for line in full)
+    assert sum("mesh gates: " in line for line in full) == 4, full
+    assert quick.refinement == eager.refinement == 3
+    assert np.array_equal(quick.extraction.mesh.faces, eager.extraction.mesh.faces)
+    assert [(g.name, g.value, g.passed) for g in quick.gates] == [
+        (g.name, g.value, g.passed) for g in eager.gates
+    ]
+
+
+def test_when_every_lattice_has_the_wrong_genus_the_finest_is_reported(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """With the budget cut to one refinement the quadruped's two lattices both close the handle: the
+    report is the finer one, judged in full, and the coarser (deferred) one is never judged."""
+    monkeypatch.setattr(build, "_may_refine", lambda refinement, grid, tier="hero": refinement < 1)
+    said: list[str] = []
+    result = _validated(UNTIL_FINE, "distant", said)
+    assert result.refinement == 1
+    failed = [g.name for g in result.gates if not g.passed]
+    assert "euler" in failed
+    assert len(result.gates) > 1
+    assert not any("judging refinement 0 in full" in line for line in said), said
+
+
+@pytest.mark.parametrize(
+    ("failed", "some", "expected"),
+    [
+        (["vertexNormalAngleMax"], ["faceNormalAngleMax"], False),  # as many, another gate
+        (["vertexNormalAngleMax"], ["vertexNormalAngleMax", "faceNormalAngleMax"], False),
+        (["vertexNormalAngleMax"], ["vertexNormalAngleMax"], True),
+        (["vertexNormalAngleMax", "faceNormalAngleMax"], ["faceNormalAngleP99"], True),  # fewer so far
+        ([], ["faceNormalAngleMax"], False),
+        ([], [], True),
+    ],
+)
+def test_a_remedy_is_turned_down_early_only_when_no_full_pass_could_keep_it(
+    failed: list[str], some: list[str], expected: bool
+) -> None:
+    """The other gates can only add failures: whenever ``_may_be_no_worse`` says no, every superset of
+    ``some`` (what a full pass could find) fails ``_no_worse`` too, and when it says yes, ``some`` itself
+    (a full pass that adds nothing) is kept."""
+    assert build._may_be_no_worse(failed, some) == expected
+    others = ["euler", "selfIntersections", "surfaceToZeroSet"]
+    supersets = [some + others[:n] for n in range(len(others) + 1)]
+    if not expected:
+        assert not any(build._no_worse(failed, full) for full in supersets)
+    else:
+        assert build._no_worse(failed, some)

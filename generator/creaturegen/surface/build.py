@@ -42,9 +42,17 @@ from .correct import CorrectionReport, correct, trust_radius
 from .extract import Extraction, extract
 from .field64 import BodyField
 from .flips import flip_to_field
-from .gates import DISTANCE_TOL, Direction, SurfaceGate, mesh_gates
+from .gates import (
+    DISTANCE_TOL,
+    FACE_NORMAL_P99_DEG,
+    VERTEX_NORMAL_P99_DEG,
+    Direction,
+    SurfaceGate,
+    mesh_gates,
+    normal_gates,
+)
 from .grid import FIRST_CELLS_LIMIT, Grid, GridTooFineError, make_grid, tier_offset
-from .handles import handle_contacts
+from .handles import certain_handle_possible, handle_contacts
 from .mesh import Mesh
 from .sampling import sample_band
 from .skeleton import Skeleton, build_skeleton
@@ -90,6 +98,8 @@ FACE_NORMAL_MAX_DEG = 60.0
 CREASE_BAND_CELLS = 2.0
 #: The mesh gates an edge flip (surface/flips.py) and a local subdivision (surface/subdivide.py) can mend,
 #: tried in that order before a finer lattice.
+#: (vertex max, vertex p99, face max, face p99) normal angles, degrees: every mesh gate pass uses these.
+NORMAL_LIMITS = (VERTEX_NORMAL_MAX_DEG, VERTEX_NORMAL_P99_DEG, FACE_NORMAL_MAX_DEG, FACE_NORMAL_P99_DEG)
 NORMAL_GATES = frozenset(
     {"vertexNormalAngleMax", "vertexNormalAngleP99", "faceNormalAngleMax", "faceNormalAngleP99", "inverted"}
 )
@@ -404,13 +414,26 @@ def _fail_on(gates: list[SurfaceGate], where: str, remedy: str = "") -> None:
         )
 
 
-def _mesh_remedy(refinement: int, spacing: float) -> str:
-    """What the build tried for a mesh gate, and what the user can change (the gate names the place)."""
+def _mesh_remedy(gates: list[SurfaceGate], certain: bool, refinement: int, spacing: float) -> str:
+    """What the build tried for a failed mesh gate, and what the user can change (the gate names the
+    place). A wrong genus gets no flips or splits (they cannot change it), and its detail already names
+    the contacts to move, so widening a blend would be the wrong advice there."""
+    where = f"refinement {refinement} at h = {spacing:.3g} m"
+    if any(g.name == "euler" and not g.passed for g in gates):
+        if certain:
+            return (
+                f" (at {where}; the field closes these handles at any lattice): move or shrink the parts "
+                "named so they meet only at their joints"
+            )
+        return (
+            f"; refining the lattice did not open the handles (the finest lattice tried, {where}, is "
+            "reported): move or shrink the parts named so they meet only at their joints"
+        )
     return (
         f"; flipping edges, splitting triangles toward the field and refining the lattice did not help "
-        f"(the best lattice tried, refinement {refinement} at "
-        f"h = {spacing:.3g} m, is reported): a feature there is thinner or tighter than the lattice "
-        "resolves; thicken the part named, or widen the blend k (or the gap) where it meets its neighbour"
+        f"(the best lattice tried, {where}, is reported): a feature there is thinner or tighter than the "
+        "lattice resolves; thicken the part named, or widen the blend k (or the gap) where it meets its "
+        "neighbour"
     )
 
 
@@ -430,8 +453,10 @@ def surface_mesh_gates(
         field=rest_field.field,
         expected_components=policy.expected,
         min_angle_bound_deg=MIN_ANGLE_P1_DEG,
-        vertex_normal_max_deg=VERTEX_NORMAL_MAX_DEG,
-        face_normal_max_deg=FACE_NORMAL_MAX_DEG,
+        vertex_normal_max_deg=NORMAL_LIMITS[0],
+        vertex_normal_p99_deg=NORMAL_LIMITS[1],
+        face_normal_max_deg=NORMAL_LIMITS[2],
+        face_normal_p99_deg=NORMAL_LIMITS[3],
         smooth=rest_field.smooth(CREASE_BAND_CELLS * spacing),
     )
     strays = f"components {list(policy.strays)} own no slot" if policy.strays else ""
@@ -498,6 +523,7 @@ class ValidatedMesh:
     refinement: int
     sampling: SamplingReport
     timings: dict[str, float]
+    deferred: bool = False  # euler failed with no certain handle: the other gates wait (``_deferred``)
 
 
 def _may_refine(refinement: int, grid: Grid, tier: str = DEFAULT_TIER) -> bool:
@@ -515,43 +541,61 @@ def _failed_count(attempt: ValidatedMesh) -> int:
     return sum(not g.passed for g in attempt.gates)
 
 
+def _fails_euler(attempt: ValidatedMesh) -> bool:
+    return any(g.name == "euler" and not g.passed for g in attempt.gates)
+
+
 def validated_mesh(
     rig: CompiledRig, skeleton: Skeleton, tier: str, chosen: FieldBackend, why: str, progress: Progress
 ) -> ValidatedMesh:
     """Sample, extract and gate; retry √2 finer while a mesh gate fails and the refinement budget lasts
     (``_may_refine``). The result is the first lattice that passes or, when none does, the one that
-    failed the fewest gates: refining can make a mesh worse (two parts closer than a finer lattice
-    resolves open a handle the coarser one had closed), and the user should hear about the best."""
-    best: ValidatedMesh | None = None
+    failed the fewest gates (the first of those): refining can make a mesh worse (two parts closer than a
+    finer lattice resolves open a handle the coarser one had closed), and the user should hear about the
+    best. When every lattice has the wrong genus it is the finest, whose contacts are the best resolved.
+    A lattice refined at once for its genus (``ValidatedMesh.deferred``) is judged in full only when
+    that choice needs it, so the choice is the one that judging every lattice in full would make."""
     attempts: list[ValidatedMesh] = []
     refinement = 0
     while True:
         try:
             attempt = _one_lattice(rig, skeleton, tier, chosen, why, progress, refinement)
         except GridTooFineError as exc:
-            if best is None:
+            if not attempts:
                 raise
             progress(f"no finer lattice: {exc}")
             break
         attempts.append(attempt)
-        if best is None or _failed_count(attempt) < _failed_count(best):
-            best = attempt
         failed = [g.name for g in attempt.gates if not g.passed]
         if not failed:
             break
-        if failed == ["euler"] and attempt.policy.handles_certain:
-            progress("the field itself closes these handles: a finer lattice cannot open them")
-            break
-        if not _may_refine(refinement, attempt.grid, tier):
-            break
+        if not attempt.deferred:
+            if failed == ["euler"] and attempt.policy.handles_certain:
+                progress("the field itself closes these handles: a finer lattice cannot open them")
+                break
+            if not _may_refine(refinement, attempt.grid, tier):
+                break
         progress("refining the lattice by √2 and extracting again")
         refinement += 1
+    last = attempts[-1]
+    if last.deferred or _failed_count(last):
+        if all(_fails_euler(a) for a in attempts):
+            # Every lattice has the wrong genus: the finest resolves the contacts best, and the coarser
+            # ones need no judging in full to lose to it.
+            attempts[-1] = _judged_in_full(rig, skeleton, last, progress) if last.deferred else last
+            best = attempts[-1]
+        else:
+            attempts = [_judged_in_full(rig, skeleton, a, progress) if a.deferred else a for a in attempts]
+            best = min(attempts, key=_failed_count)
+    else:
+        best = last
     spent = {key: sum(a.timings[key] for a in attempts) for key in best.timings}
     best = replace(best, timings=spent)
-    if best.refinement != attempt.refinement:
+    last = attempts[-1]
+    if best.refinement != last.refinement:
         progress(
             f"keeping refinement {best.refinement} ({_failed_count(best)} failed gates) over the finer "
-            f"refinement {attempt.refinement} ({_failed_count(attempt)} failed)"
+            f"refinement {last.refinement} ({_failed_count(last)} failed)"
         )
     return best
 
@@ -565,7 +609,7 @@ def _one_lattice(
     progress: Progress,
     refinement: int,
 ) -> ValidatedMesh:
-    """One lattice: sample, extract and gate."""
+    """One lattice: sample, extract and gate (or, when ``_deferred``, only the genus)."""
     timings: dict[str, float] = {"sampling": 0.0, "extraction": 0.0, "validation": 0.0}
     rest_field = BodyField(rig.graph, rig.slots)
     grid = make_grid(rig.slots, rig.graph, tier, rig.slot_parts, refinement)
@@ -589,24 +633,6 @@ def _one_lattice(
     ex = extract(rest_field, band, rig.body_scale)
     timings["extraction"] += time.perf_counter() - t
     progress(f"extracted {ex.mesh.vertex_count:,} vertices, {ex.mesh.face_count:,} triangles")
-    t = time.perf_counter()
-    gates, policy = surface_mesh_gates(rig, ex, rest_field, skeleton, grid.spacing)
-    timings["validation"] += time.perf_counter() - t
-    failed = [g.name for g in gates if not g.passed]
-    progress(
-        f"mesh gates: {len(gates) - len(failed)}/{len(gates)} passed"
-        + (f"; failed {failed}" if failed else "")
-    )
-    refining = "euler" in failed and not policy.handles_certain and _may_refine(refinement, grid, tier)
-    if any(name in NORMAL_GATES for name in failed) and not refining:
-        # Not when the genus is wrong and a finer lattice follows anyway: neither remedy changes the
-        # topology, so it cannot spare that lattice, and re-gating a large mesh for it cost seed 88 nine
-        # seconds.
-        t = time.perf_counter()
-        ex, gates, policy, failed = _remedied(
-            rig, ex, gates, policy, failed, rest_field, skeleton, grid, progress
-        )
-        timings["validation"] += time.perf_counter() - t
     sampling = SamplingReport(
         chosen.name,
         why,
@@ -618,7 +644,92 @@ def _one_lattice(
         band.total_blocks,
         timings["sampling"],
     )
+    t = time.perf_counter()
+    genus = _deferred(rig, ex, rest_field, skeleton, grid, refinement, tier)
+    timings["validation"] += time.perf_counter() - t
+    if genus is not None:
+        progress(
+            f"mesh gates: euler failed ({genus.detail}); no contact between unjoined parts is certain to "
+            "stay, so a finer lattice follows and the other gates wait"
+        )
+        policy = ComponentPolicy(0, (), (), (), (), ())
+        return ValidatedMesh(ex, [genus], policy, grid, refinement, sampling, timings, deferred=True)
+    refine_next = _may_refine(refinement, grid, tier)
+    ex, gates, policy, _ = _gated(rig, ex, rest_field, skeleton, grid, timings, progress, refine_next)
     return ValidatedMesh(ex, gates, policy, grid, refinement, sampling, timings)
+
+
+def _deferred(
+    rig: CompiledRig,
+    ex: Extraction,
+    rest_field: BodyField,
+    skeleton: Skeleton,
+    grid: Grid,
+    refinement: int,
+    tier: str,
+) -> SurfaceGate | None:
+    """The failed euler gate when this lattice will be refined whatever its other gates say, else None.
+
+    That is when the genus is wrong, a finer lattice is within the budget, and no handle can be certain
+    (handles.certain_handle_possible): the build then refines without remedies, and the lattice's other
+    gates matter only if no finer one passes, when ``_judged_in_full`` computes them. On a 160k-vertex
+    first lattice they cost ~11 s (gates, component policy, a genus per contacting pair of parts)."""
+    if not _may_refine(refinement, grid, tier):
+        return None
+    found = components(ex.mesh)
+    off = np.flatnonzero(found.euler != 2)
+    if off.size == 0:
+        return None
+    distances = rest_field.slot_distances(ex.mesh.vertices)
+    if certain_handle_possible(ex.mesh, distances, rest_field.distance, skeleton, rig.slots, rig.slot_parts):
+        return None
+    detail = f"genus {found.genus[off][:5].tolist()} at components {off[:5].tolist()}"
+    return SurfaceGate("euler", float(off.size), 0.0, "components", "max", detail)
+
+
+def _judged_in_full(
+    rig: CompiledRig, skeleton: Skeleton, attempt: ValidatedMesh, progress: Progress
+) -> ValidatedMesh:
+    """A deferred lattice with every gate computed, as ``_one_lattice`` would have judged it."""
+    rest_field = BodyField(rig.graph, rig.slots)
+    timings = dict(attempt.timings)
+    progress(f"no finer lattice passed: judging refinement {attempt.refinement} in full")
+    ex, gates, policy, _ = _gated(
+        rig, attempt.extraction, rest_field, skeleton, attempt.grid, timings, progress
+    )
+    return replace(attempt, extraction=ex, gates=gates, policy=policy, timings=timings, deferred=False)
+
+
+def _gated(
+    rig: CompiledRig,
+    ex: Extraction,
+    rest_field: BodyField,
+    skeleton: Skeleton,
+    grid: Grid,
+    timings: dict[str, float],
+    progress: Progress,
+    refine_next: bool = False,
+) -> Remedy:
+    """Every mesh gate of one lattice, after the local normal remedies when they may pass it
+    (``refine_next``: a finer lattice follows unless this one passes)."""
+    t = time.perf_counter()
+    gates, policy = surface_mesh_gates(rig, ex, rest_field, skeleton, grid.spacing)
+    timings["validation"] += time.perf_counter() - t
+    failed = [g.name for g in gates if not g.passed]
+    progress(
+        f"mesh gates: {len(gates) - len(failed)}/{len(gates)} passed"
+        + (f"; failed {failed}" if failed else "")
+    )
+    if any(name in NORMAL_GATES for name in failed) and "euler" not in failed:
+        # Not when the genus is wrong: neither remedy changes the topology, so it can neither spare a
+        # finer lattice nor pass this one, and re-gating a large mesh for it cost seed 88 nine seconds
+        # (and seed 83's refusal seven).
+        t = time.perf_counter()
+        ex, gates, policy, failed = _remedied(
+            rig, ex, gates, policy, failed, rest_field, skeleton, grid, progress, refine_next
+        )
+        timings["validation"] += time.perf_counter() - t
+    return ex, gates, policy, failed
 
 
 def _no_worse(failed: list[str], still: list[str]) -> bool:
@@ -639,13 +750,15 @@ def _remedied(
     skeleton: Skeleton,
     grid: Grid,
     progress: Progress,
+    refine_next: bool = False,
 ) -> Remedy:
     """The local remedies for mesh-normal gates, before a whole finer lattice: edge flips toward the field
     (triangles spanning a bend along the wrong diagonal, surface/flips.py), then splits where the normals
     still disagree (surface/subdivide.py; only when the topology and the distances pass, which only a
     finer lattice mends). Each is kept only when it is ``_no_worse``. When only normal gates fail, both
     are applied and their sum is gated once (one gate pass on a 240k-vertex mesh takes ~15 s); the flips
-    alone are gated only when the sum is not kept."""
+    alone are gated only when the sum is not kept. With ``refine_next`` a remedy is worth a full gate pass
+    only when it may pass the lattice (``_judged``)."""
     flipped_mesh, flips = flip_to_field(ex.mesh, rest_field.gradient)
     flipped = replace(ex, mesh=flipped_mesh)
 
@@ -662,7 +775,7 @@ def _remedied(
             )
             if not added:
                 continue
-            kept, result = _judged(rig, candidate, against, rest_field, skeleton, grid)
+            kept, result = _judged(rig, candidate, against, rest_field, skeleton, grid, refine_next)
             what = (
                 "where the normals disagree"
                 if marks != TAIL_MARKS
@@ -681,7 +794,7 @@ def _remedied(
     if only_normals and (both := split(flipped, flips)) is not None:
         return both
     if flips:
-        kept, result = _judged(rig, flipped, failed, rest_field, skeleton, grid)
+        kept, result = _judged(rig, flipped, failed, rest_field, skeleton, grid, refine_next)
         progress(f"{flips} edges flipped toward the field: " + _verdict(result, kept))
         if kept:
             ex, gates, policy, failed = result
@@ -772,17 +885,43 @@ def _judged(
     rest_field: BodyField,
     skeleton: Skeleton,
     grid: Grid,
+    refine_next: bool = False,
 ) -> tuple[bool, Remedy]:
-    """A remedied extraction gated again: (kept, its result), kept when ``_no_worse`` than ``failed``."""
+    """A remedied extraction gated again: (kept, its result), kept when ``_no_worse`` than ``failed``.
+
+    The normal-angle gates go first (gates.normal_gates, the same values a full pass computes): a remedy
+    that already fails more of them, or other ones, than ``failed`` cannot be kept whatever the rest say,
+    and is turned down without them (a full pass on a 140k-vertex mesh is ~5 s, the normals ~2 s). With
+    ``refine_next`` (a finer lattice follows unless this one passes) so is one that still fails a max
+    normal gate: no later remedy step mends those (the tail split answers only the p99 gates), so it
+    cannot spare the finer lattice, and keeping it would only change which failure a refusal reports."""
+    smooth = rest_field.smooth(CREASE_BAND_CELLS * grid.spacing)
+    normals = normal_gates(
+        candidate.mesh,
+        length_scale=rig.body_scale,
+        field=rest_field.field,
+        normal_limits=NORMAL_LIMITS,
+        smooth=smooth,
+    )
+    partial = [g.name for g in normals if not g.passed]
+    if not _may_be_no_worse(failed, partial) or (refine_next and set(partial) - P99_GATES):
+        return False, (candidate, normals, ComponentPolicy(0, (), (), (), (), ()), partial)
     again, again_policy = surface_mesh_gates(rig, candidate, rest_field, skeleton, grid.spacing)
     still = [g.name for g in again if not g.passed]
     return _no_worse(failed, still), (candidate, again, again_policy, still)
 
 
+def _may_be_no_worse(failed: list[str], some: list[str]) -> bool:
+    """Whether a mesh whose failures include ``some`` can still be ``_no_worse`` than ``failed``: the other
+    gates can only add failures, so not once ``some`` outnumbers ``failed`` or, as many, is not a subset."""
+    return len(some) < len(failed) or (len(some) == len(failed) and set(some) <= set(failed))
+
+
 def _verdict(result: Remedy, kept: bool) -> str:
     gates, still = result[1], result[3]
+    which = "normal-angle" if all(g.name in NORMAL_GATES for g in gates) else "mesh"
     return (
-        f"mesh gates {len(gates) - len(still)}/{len(gates)} passed"
+        f"{which} gates {len(gates) - len(still)}/{len(gates)} passed"
         + (f"; failed {still}" if still else "")
         + ("" if kept else " (not kept)")
     )
@@ -875,7 +1014,9 @@ def _extract_with(
     if policy.detached:
         progress(f"declared: {', '.join(policy.detached)} detached from the body (the field leaves a gap)")
     if strict:
-        _fail_on(gates, f"surface {tier}", _mesh_remedy(refinement, grid.spacing))
+        _fail_on(
+            gates, f"surface {tier}", _mesh_remedy(gates, policy.handles_certain, refinement, grid.spacing)
+        )
 
     t = time.perf_counter()
     still = envelope.still_joints(rig.body_scale)

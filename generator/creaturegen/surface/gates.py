@@ -470,21 +470,6 @@ def field_gates(
         coverage = math.inf
         coverage_detail = f"no seed of {seeds.shape[0]} converged onto the zero set"
 
-    used = np.unique(mesh.faces.reshape(-1)).astype(np.int64)
-    feet, _, at_feet = project_to_zero_set(
-        centroids, distance, gradient, NEWTON_STEPS, tol, field=fused, initial=at_centroids
-    )
-    face_ids = np.arange(mesh.face_count, dtype=np.int64)
-    if smooth is not None:
-        used = used[smooth(mesh.vertices[used])]
-        keep = smooth(feet)
-        face_ids, feet, fn, at_feet = face_ids[keep], feet[keep], fn[keep], at_feet[keep]
-    vertex_angles = angles_deg(normals[used], gradient(mesh.vertices[used]))
-    face_angles = angles_deg(fn, at_feet)
-    v_areas = vertex_areas(mesh)[used]
-    f_areas = np.linalg.norm(fn, axis=1)
-
-    vmax, vp99, fmax, fp99 = normal_limits
     return [
         _count_gate(
             "inverted",
@@ -503,6 +488,64 @@ def field_gates(
             _point(samples[far]) if far >= 0 else None,
         ),
         SurfaceGate("zeroSetToMesh", coverage, coverage_tol, "L", "max", coverage_detail, coverage_at),
+        *_normal_gates(mesh, normals, (centroids, at_centroids), gradient, fused, tol, normal_limits, smooth),
+    ]
+
+
+def normal_gates(
+    mesh: Mesh,
+    *,
+    length_scale: float,
+    field: FieldFn,
+    normal_limits: Sequence[float],
+    smooth: SmoothFn | None = None,
+) -> list[SurfaceGate]:
+    """The four normal-angle gates alone, exactly as ``field_gates`` computes them: what a local remedy
+    for them must pass first, at a fraction of a full gate pass (no surface samples, coverage seeds,
+    topology or intersections)."""
+    centroids = mesh.corners().mean(axis=1)
+    tol = CONVERGED_FACTOR * float(length_scale)
+    return _normal_gates(
+        mesh,
+        vertex_normals(mesh),
+        (centroids, field(centroids)),
+        lambda q: field(q)[1],
+        field,
+        tol,
+        normal_limits,
+        smooth,
+    )
+
+
+def _normal_gates(
+    mesh: Mesh,
+    normals: F64,
+    at_centroids: tuple[F64, tuple[F64, F64]],
+    gradient: GradientFn,
+    fused: FieldFn,
+    tol: float,
+    normal_limits: Sequence[float],
+    smooth: SmoothFn | None,
+) -> list[SurfaceGate]:
+    """Vertex normals against ∇d at the vertices, face normals against ∇d at their centroids' feet on the
+    zero set (``at_centroids``: the centroids and the field there); off the crease band when ``smooth``."""
+    centroids, start = at_centroids
+    fn = mesh.face_normals()
+    used = np.unique(mesh.faces.reshape(-1)).astype(np.int64)
+    feet, _, at_feet = project_to_zero_set(
+        centroids, lambda q: fused(q)[0], gradient, NEWTON_STEPS, tol, field=fused, initial=start
+    )
+    face_ids = np.arange(mesh.face_count, dtype=np.int64)
+    if smooth is not None:
+        used = used[smooth(mesh.vertices[used])]
+        keep = smooth(feet)
+        face_ids, feet, fn, at_feet = face_ids[keep], feet[keep], fn[keep], at_feet[keep]
+    vertex_angles = angles_deg(normals[used], gradient(mesh.vertices[used]))
+    face_angles = angles_deg(fn, at_feet)
+    v_areas = vertex_areas(mesh)[used]
+    f_areas = np.linalg.norm(fn, axis=1)
+    vmax, vp99, fmax, fp99 = normal_limits
+    return [
         *_angle_gates("vertex", vertex_angles, used, mesh.vertices[used], v_areas, vmax, vp99),
         *_angle_gates("face", face_angles, face_ids, feet, f_areas, fmax, fp99),
     ]

@@ -2844,7 +2844,7 @@ export const CREATURE = Object.freeze({
     0
   ],
   "signatures": {
-    "compilerSignature": "e45c8e1db0a57b130005cffeea326bfdae0df409f325ac08c5467c5b5d14b587",
+    "compilerSignature": "9ba9e2945e434baf99a134d530adcd346a73981f8a799a92595b93bae8821712",
     "geometryDigest": "400b0d18a2a9f6bbbfe5b441f89767f552a4f3b4c45a368d1129d632e1d2f4f1",
     "topologySignature": "330d551e8c006f84b01459c84db69ca8c43aec5bc9d9083d3e85c291be5a68bf"
   },
