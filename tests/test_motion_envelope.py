@@ -108,6 +108,10 @@ def test_the_disk_copy_is_the_measured_envelope_bit_for_bit() -> None:
     env = envelope.pose_envelope(spec, rig)
     copy = envelope._from_json(envelope._to_json(env))
     assert copy.joints == env.joints
+    # Each turning joint names the run where it turns most (a refusal's message repeats it).
+    turning = [j for j in env.joints if max(j.bend_deg, j.twist_deg) > envelope.STILL_DEG]
+    assert turning
+    assert all(j.worst_run in env.runs for j in turning)
     assert copy.runs == env.runs
     assert copy.pose_labels == env.pose_labels
     assert np.array_equal(copy.slot_displacement, env.slot_displacement)

@@ -346,6 +346,12 @@ def test_a_refused_joint_says_how_far_the_motion_turns_it() -> None:
     assert "126° bend and 16° twist" in str(error)
     assert "shorter step" in str(error)
     assert "turns this joint" not in str(deform.DeformationError("part.x", []))
+    # The run whose turn set the sweep is named: a leg crushed on the slope is not a step too long.
+    on_slope = deform.DeformationError(
+        "part.leg[0]", [], 173.0, 180.0, worst_run="slope authored heading 180°"
+    )
+    assert "most in the envelope run 'slope authored heading 180°'" in str(on_slope)
+    assert "on a slope, legs long enough to reach the ground" in str(on_slope)
 
 
 def _corrector(body: Body) -> Any:

@@ -100,6 +100,7 @@ class JointEnvelope:
     bend_deg: float  # swing of the child's rest tangent
     twist_deg: float  # about the child's rest tangent
     pivot_drift: float  # |relative transform moves the pivot|, m: a joint turns about its pivot
+    worst_run: str = ""  # the run whose turn is largest (bend or twist), named in a refusal
 
 
 @dataclass(frozen=True)
@@ -154,6 +155,7 @@ class PoseEnvelope:
                     "bendDeg": j.bend_deg,
                     "twistDeg": j.twist_deg,
                     "pivotDrift": j.pivot_drift,
+                    "worstRun": j.worst_run,
                 }
                 for j in self.joints
             ],
@@ -340,8 +342,11 @@ def _root_frame(quats: F64, trans: F64, root: int) -> tuple[F64, F64]:
     return q, t
 
 
-def _joint(skeleton: Skeleton, rest: F64, q: F64, t: F64, parent: int, child: int) -> JointEnvelope:
-    """Swing and twist of the child relative to its parent at every sample; the worst of each."""
+def _joint(
+    skeleton: Skeleton, rest: F64, q: F64, t: F64, parent: int, child: int, runs: list[str]
+) -> JointEnvelope:
+    """Swing and twist of the child relative to its parent at every sample; the worst of each, and the
+    run (``runs``: each sample's) where the larger of the two peaks."""
     inverse = q[:, parent] * np.array([1.0, -1.0, -1.0, -1.0])
     rel = quaternion_multiply(inverse, q[:, child])
     rel = np.where(rel[:, :1] < 0.0, -rel, rel)
@@ -355,8 +360,13 @@ def _joint(skeleton: Skeleton, rest: F64, q: F64, t: F64, parent: int, child: in
     by_child = np.einsum("nij,j->ni", quaternion_to_matrix(q[:, child]), pivot) + t[:, child]
     by_parent = np.einsum("nij,j->ni", quaternion_to_matrix(q[:, parent]), pivot) + t[:, parent]
     drift = np.linalg.norm(by_child - by_parent, axis=1)
+    worst = int(np.argmax(np.maximum(bend, twist))) if bend.size else -1
     return JointEnvelope(
-        child, float(np.degrees(bend.max())), float(np.degrees(twist.max())), float(drift.max())
+        child,
+        float(np.degrees(bend.max())),
+        float(np.degrees(twist.max())),
+        float(drift.max()),
+        runs[worst] if worst >= 0 else "",
     )
 
 
@@ -398,7 +408,8 @@ def _summarise(
     """The envelope of the recorded runs: every joint and slot measured, the sweep poses picked."""
     root = int(data["roots"][0])
     q, t = _root_frame(quats, trans, root)
-    joints = tuple(_joint(skeleton, rest, q, t, p, c) for p, c in skeleton.joints)
+    runs = [label.rsplit(" tick ", 1)[0] for label in sample_labels]
+    joints = tuple(_joint(skeleton, rest, q, t, p, c, runs) for p, c in skeleton.joints)
     rot = quaternion_to_matrix(q)
     ends = []
     for end in (col.A, col.B):
@@ -426,7 +437,7 @@ def _to_json(env: PoseEnvelope) -> str:
             "runs": env.runs,
             "ticks": env.ticks,
             "samples": env.samples,
-            "joints": [[j.child, j.bend_deg, j.twist_deg, j.pivot_drift] for j in env.joints],
+            "joints": [[j.child, j.bend_deg, j.twist_deg, j.pivot_drift, j.worst_run] for j in env.joints],
             "slotDisplacement": env.slot_displacement.tolist(),
             "poses": [[p.rotations.tolist(), p.translations.tolist()] for p in env.poses],
             "labels": env.pose_labels,
@@ -440,7 +451,7 @@ def _from_json(text: str) -> PoseEnvelope:
         tuple(raw["runs"]),
         int(raw["ticks"]),
         int(raw["samples"]),
-        tuple(JointEnvelope(int(c), b, t, d) for c, b, t, d in raw["joints"]),
+        tuple(JointEnvelope(int(c), b, t, d, w) for c, b, t, d, w in raw["joints"]),
         np.asarray(raw["slotDisplacement"], dtype=np.float64),
         tuple(
             Pose(np.asarray(r, dtype=np.float64), np.asarray(t, dtype=np.float64)) for r, t in raw["poses"]

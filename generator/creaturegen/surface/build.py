@@ -1044,6 +1044,7 @@ def _extract_with(
         rig.body_scale,
         limits={j.child: envelope.sweep_limits(j.child) for j in envelope.joints},
         limits_from="motion envelope (motion/envelope.py), widened by its margins",
+        limits_at={j.child: j.worst_run for j in envelope.joints},
         corrector=deform.seam_corrector(
             mesh,
             ex.normals,

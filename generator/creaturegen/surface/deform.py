@@ -127,6 +127,7 @@ class DeformationError(Exception):
         bend_deg: float = 0.0,
         twist_deg: float = 0.0,
         corrected: Sequence[MethodSweep] = (),
+        worst_run: str = "",
     ) -> None:
         self.joint = joint
         self.sweeps = tuple(sweeps)
@@ -141,10 +142,12 @@ class DeformationError(Exception):
         failed = listed(sweeps)
         if corrected:
             failed += f"; tried with the seam corrected toward the field: {listed(corrected)}"
+        where = f", most in the envelope run '{worst_run}'" if worst_run else ""
         reach = (
             f"; the motion turns this joint up to {bend_deg:.0f}° bend and {twist_deg:.0f}° twist (swept "
-            "with its margin): a smaller turn (a shorter step or hop, a longer limb) or a thinner limb at "
-            "the joint keeps it within what skinning can carry"
+            f"with its margin{where}): a smaller turn (a shorter step or hop, a longer limb; on a slope, "
+            "legs long enough to reach the ground under the whole body, which stays upright) or a thinner "
+            "limb at the joint keeps it within what skinning can carry"
             if bend_deg or twist_deg
             else ""
         )
@@ -1163,6 +1166,7 @@ def choose_deformation(
     limits: Mapping[int, tuple[float, float]] | None = None,
     limits_from: str = "",
     corrector: _Corrector | None = None,
+    limits_at: Mapping[int, str] | None = None,
 ) -> DeformationChoice:
     """Sweep every joint with every method and keep, per joint, the first method that passes every gate.
 
@@ -1171,7 +1175,8 @@ def choose_deformation(
     :func:`centers_of_rotation`) are computed when not given. ``limits`` maps a joint's child slot to its
     (bend, twist) sweep limits in degrees (the measured motion envelope, motion/envelope.py); a joint not
     in it is swept to ``bend_max_deg`` and ``twist_max_deg``. A joint swept to zero never turns: every
-    method reproduces it exactly and the cheapest is kept.
+    method reproduces it exactly and the cheapest is kept. ``limits_at`` names, per joint, the motion
+    whose turn set its limits, for a refusal's message.
 
     Remedy before refusal: where no method passes by skinning alone and a ``corrector`` is given
     (:func:`seam_corrector`), the joint is swept again with every method's seam corrected toward the
@@ -1202,6 +1207,7 @@ def choose_deformation(
     joints = []
     for parent, child in skeleton.joints:
         bend, twist = (limits or {}).get(child, (bend_max_deg, twist_max_deg))
+        worst = (limits_at or {}).get(child, "")
         poses = sweep_poses(skeleton, rig_slots, child, bend, twist, steps)
         result = _joint_sweep(rest, idx, w, skeleton, rig_slots, graph, length_scale, child, poses)
         sweeps = result.sweeps
@@ -1213,10 +1219,10 @@ def choose_deformation(
             )
             chosen = next((s.method for s in retry.sweeps if s.passed), None)
             if chosen is None:
-                raise DeformationError(skeleton.names[child], sweeps, bend, twist, retry.sweeps)
+                raise DeformationError(skeleton.names[child], sweeps, bend, twist, retry.sweeps, worst)
             result, sweeps, corrected = retry, retry.sweeps, True
         if chosen is None:
-            raise DeformationError(skeleton.names[child], sweeps, bend, twist)
+            raise DeformationError(skeleton.names[child], sweeps, bend, twist, worst_run=worst)
         methods[child] = chosen
         radius = float(rig_slots[child, col.RA])
         joints.append(
