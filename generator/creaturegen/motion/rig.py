@@ -19,6 +19,10 @@ from . import quat as vq
 
 #: Walkers, hoppers and swimmers circle at this many body lengths (flyers use their spec radius).
 PATH_RADIUS_BODIES: Final = 6.0
+#: Share of a leg's room to full extension (reachMax less its rest hip-foot distance) that an upright
+#: body on a slope may ask of its downhill legs, so it sits higher than its lowest foot
+#: (simulate.Motion._settle): halfway between its lowest and highest rest foot, where that room allows.
+SETTLE_SLACK: Final = 0.25
 #: Swing time ``SWING_FROUDE·sqrt(leg/g)`` (dynamic similarity: equal Froude number across leg lengths).
 SWING_FROUDE: Final = 1.0
 #: A foot lands this fraction of stepLength ahead of its home; it lifts when it lags stepLength behind.
@@ -242,6 +246,7 @@ def build_motion(spec: CharacterSpec, rig: CompiledRig, skeleton: Skeleton) -> d
                 "constants": {
                     "swingFroude": SWING_FROUDE,
                     "stepLead": STEP_LEAD,
+                    "settleSlack": SETTLE_SLACK,
                     "hopCrouchS": HOP_CROUCH_S,
                     "hopLandS": HOP_LAND_S,
                     "hopSquash": HOP_SQUASH,

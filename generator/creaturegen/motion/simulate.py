@@ -176,15 +176,20 @@ class Motion:
         return [ground[0], y, ground[2], c, s, squash]
 
     def _settle(self, frame: Frame, c: float, s: float) -> float:
-        """How far an upright body sinks so no rest foot is further below its hip than on level ground:
-        the support height under each rest foot, relative to under the root, at its lowest (≤ 0)."""
+        """How far an upright body sinks on a tilted support: halfway between its lowest and highest rest
+        foot's support height (relative to under the root), but never so far that a downhill leg must
+        reach past ``settleSlack`` of the room its rest pose leaves to full extension. Sinking to the lowest
+        foot, as it did, folded the uphill legs of a long body to a twentieth of their reach and turned
+        their hips over (generated seed 189 on the 10° slope)."""
         ny = frame[7]
-        lowest = 0.0
+        lowest = highest = 0.0
+        room = math.inf
         for leg in self.data["legs"]:
             r = vq.yaw_rotate(c, s, leg["foot"])
             dy = -(frame[6] * r[0] + frame[8] * r[2]) / ny
-            lowest = min(lowest, dy)
-        return lowest
+            lowest, highest = min(lowest, dy), max(highest, dy)
+            room = min(room, leg["reachMax"] - vq.distance(leg["hip"], leg["foot"]))
+        return lowest + min(0.5 * (highest - lowest), self.data["constants"]["settleSlack"] * max(room, 0.0))
 
     def _hop(self, n: int) -> tuple[float, float, float]:
         """(distance along the path, height above the support, squash) of the hopper at tick ``n``. In the
