@@ -189,7 +189,8 @@ class Motion:
             dy = -(frame[6] * r[0] + frame[8] * r[2]) / ny
             lowest, highest = min(lowest, dy), max(highest, dy)
             room = min(room, leg["reachMax"] - vq.distance(leg["hip"], leg["foot"]))
-        return lowest + min(0.5 * (highest - lowest), self.data["constants"]["settleSlack"] * max(room, 0.0))
+        slack = float(self.data["constants"]["settleSlack"])
+        return lowest + min(0.5 * (highest - lowest), slack * max(room, 0.0))
 
     def _hop(self, n: int) -> tuple[float, float, float]:
         """(distance along the path, height above the support, squash) of the hopper at tick ``n``. In the
