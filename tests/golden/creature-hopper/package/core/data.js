@@ -50,6 +50,7 @@ export const CREATURE = Object.freeze({
       "ropeDamping": 0.02,
       "ropePasses": 4,
       "ropeSubsteps": 2,
+      "settleSlack": 0.25,
       "stepLead": 0.5,
       "strouhal": 0.3,
       "swimResponse": 1.0,
@@ -2844,7 +2845,7 @@ export const CREATURE = Object.freeze({
     0
   ],
   "signatures": {
-    "compilerSignature": "9ba9e2945e434baf99a134d530adcd346a73981f8a799a92595b93bae8821712",
+    "compilerSignature": "6a8d874de7b331ac3a8f67be42344c34fc662d15b1f921688ecdc1e6718ffc8f",
     "geometryDigest": "400b0d18a2a9f6bbbfe5b441f89767f552a4f3b4c45a368d1129d632e1d2f4f1",
     "topologySignature": "330d551e8c006f84b01459c84db69ca8c43aec5bc9d9083d3e85c291be5a68bf"
   },

@@ -141,19 +141,26 @@ export function createMotion(data, lcg, { support = createFlatGround(), gravity 
     out[2] = -sc[2];
   }
 
-  /** How far the upright body sinks on a tilted support (heading c, s = hs[0], hs[1]) into hs[2]. */
+  /** How far the upright body sinks on a tilted support (heading c, s = hs[0], hs[1]) into hs[2]: halfway
+   * between its lowest and highest rest foot, within constants.settleSlack of the legs' room to full
+   * extension (motion/simulate.py Motion._settle). */
   function settle(f, hs) {
     const c = hs[0], s = hs[1];
     const ny = f[7];
-    let lowest = 0;
+    let lowest = 0, highest = 0, room = Infinity;
     for (let i = 0; i < L; i++) {
-      const ft = m.legs[i].foot;
+      const leg = m.legs[i];
+      const ft = leg.foot, hp = leg.hip;
       const rx = c * ft[0] + s * ft[2];
       const rz = -s * ft[0] + c * ft[2];
       const dy = -(f[6] * rx + f[8] * rz) / ny;
       if (dy < lowest) lowest = dy;
+      if (dy > highest) highest = dy;
+      const ex = hp[0] - ft[0], ey = hp[1] - ft[1], ez = hp[2] - ft[2];
+      const spare = leg.reachMax - Math.sqrt(ex * ex + ey * ey + ez * ez);
+      if (spare < room) room = spare;
     }
-    hs[2] = lowest;
+    hs[2] = lowest + Math.min(0.5 * (highest - lowest), m.constants.settleSlack * Math.max(room, 0));
   }
 
   /** Root on the support at (u, w) = p[0], p[1], heading ψ = p[2]; ls = (lift, squash). */
