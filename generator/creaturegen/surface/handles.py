@@ -102,17 +102,22 @@ def surface_genus(mesh: Mesh) -> float:
     fan = corner_fans(mesh, table)
     fans = np.unique(fan).size
     chi = fans - int(table.valence.size) + int(mesh.faces.shape[0])
-    half = np.flatnonzero(table.valence[table.edge_of_half] == 1)
-    loops = 0
-    if half.size:
-        nxt = 3 * (half // 3) + (half % 3 + 1) % 3
-        used, local = np.unique(np.concatenate([fan[half], fan[nxt]]), return_inverse=True)
-        graph = coo_matrix(
-            (np.ones(half.size), (local[: half.size], local[half.size :])), shape=(used.size, used.size)
-        )
-        parts, _ = connected_components(graph, directed=False)
-        loops = half.size - used.size + parts
+    loops = _boundary_loops(np.flatnonzero(table.valence[table.edge_of_half] == 1), fan)
     return (2 * found.count - chi - loops) / 2.0
+
+
+def _boundary_loops(half: I64, fan: I64) -> int:
+    """Cycle rank of the boundary half-edges ``half`` over their ends' fans (``fan``: each corner's fan
+    label; half-edge 3f+i runs from corner 3f+i to the next corner of face f)."""
+    if half.size == 0:
+        return 0
+    nxt = 3 * (half // 3) + (half % 3 + 1) % 3
+    used, local = np.unique(np.concatenate([fan[half], fan[nxt]]), return_inverse=True)
+    graph = coo_matrix(
+        (np.ones(half.size), (local[: half.size], local[half.size :])), shape=(used.size, used.size)
+    )
+    parts, _ = connected_components(graph, directed=False)
+    return int(half.size - used.size + parts)
 
 
 @dataclass(frozen=True)
@@ -168,16 +173,7 @@ def cut_genus(base: Uncut, strip: npt.NDArray[np.bool_]) -> float:
         shape=(n + e, n + e),
     )
     count = int(connected_components(graph.tocsr(), directed=False)[0]) - (n - kept_faces) - (e - edges)
-    half = np.flatnonzero(kept_half & (valence[base.table.edge_of_half] == 1))
-    loops = 0
-    if half.size:
-        nxt = 3 * (half // 3) + (half % 3 + 1) % 3
-        used, local = np.unique(np.concatenate([fan[half], fan[nxt]]), return_inverse=True)
-        loop_graph = coo_matrix(
-            (np.ones(half.size), (local[: half.size], local[half.size :])), shape=(used.size, used.size)
-        )
-        parts, _ = connected_components(loop_graph, directed=False)
-        loops = half.size - used.size + parts
+    loops = _boundary_loops(np.flatnonzero(kept_half & (valence[base.table.edge_of_half] == 1)), fan)
     return float(2 * count - chi - loops) / 2.0
 
 
