@@ -893,8 +893,10 @@ def _judged(
     that already fails more of them, or other ones, than ``failed`` cannot be kept whatever the rest say,
     and is turned down without them (a full pass on a 140k-vertex mesh is ~5 s, the normals ~2 s). With
     ``refine_next`` (a finer lattice follows unless this one passes) so is one that still fails a max
-    normal gate: no later remedy step mends those (the tail split answers only the p99 gates), so it
-    cannot spare the finer lattice, and keeping it would only change which failure a refusal reports."""
+    normal gate: as it stands it cannot pass the lattice. This is a choice, not an equivalence: a kept
+    remedy could have been the base of a later step (the tail split, when a p99 gate also failed, or the
+    split after flips), which is then tried from the unremedied mesh or not at all, so such a lattice
+    gets one remedy path fewer before the finer lattice (which the corpus measures)."""
     smooth = rest_field.smooth(CREASE_BAND_CELLS * grid.spacing)
     normals = normal_gates(
         candidate.mesh,
