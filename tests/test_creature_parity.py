@@ -371,6 +371,39 @@ def test_the_job_catches_a_spawn_that_spreads_bodies_over_pages(out_root: Path, 
 
 
 @pytest.mark.browser
+def test_the_job_catches_a_page_drawn_twice_in_a_pass(out_root: Path, tmp_path: Path) -> None:
+    """A second mesh per page over the same geometry and material (an outline proxy, say) keeps the pages
+    in use right but draws each page twice in the display pass: the draws-beyond-pages gate fails, and
+    the pages-in-use gate stays quiet (the defect is in the draws, not in where bodies go)."""
+    package = build("reference/hopper.json", out_root)
+    planted = _planted(
+        package,
+        tmp_path,
+        "population.js",
+        [
+            (
+                "    page.mesh.material = materialFor(page, m);\n",
+                "    page.mesh.material = materialFor(page, m);\n"
+                "    if (!page.twin) {\n"
+                "      page.twin = new THREE.Mesh(geometry, null);\n"
+                "      page.twin.boundingSphere = page.mesh.boundingSphere;\n"
+                "      group.add(page.twin);\n"
+                "    }\n"
+                "    page.twin.material = page.mesh.material;\n",
+            ),
+            (
+                "    page.mesh.count = last + 1;\n",
+                "    page.mesh.count = last + 1;\n    if (page.twin) page.twin.count = page.mesh.count;\n",
+            ),
+        ],
+    )
+    report = run_creature_parity(planted, groups=("population",))
+    failed = {g["name"] for g in report.gates if g["status"] == "fail"}
+    assert "body draw calls in a render pass beyond pages in use (encoder count)" in failed, report.summary()
+    assert f"pose pages in use after {SPAWNS} spawns of pageSize {PAGE_SIZE}" not in failed, report.summary()
+
+
+@pytest.mark.browser
 def test_the_job_catches_a_wrong_gradient(out_root: Path, tmp_path: Path) -> None:
     """A blend gradient with its y component doubled leaves every distance right and every normal wrong."""
     package = build("reference/hopper.json", out_root)
