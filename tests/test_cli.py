@@ -151,6 +151,30 @@ def test_a_valid_spec_a_build_gate_refuses_exits_3_and_writes_nothing(tmp_path: 
     assert after == before
 
 
+def test_posed_skin_faults_are_reported_by_default_and_refused_on_request(tmp_path: Path) -> None:
+    """The hopper's counter-tail folds its skin out of the body at a pose of its own hop cycle
+    (surface/posed.py). By default the build writes the package, prints a warning naming the gate and
+    records the gates in the build report; with --posed-gates refuse the same surface (a cache hit the
+    second time) is refused with exit 3, naming the part and the pose, and nothing is written."""
+    spec = EXAMPLES / "reference" / "hopper.json"
+    out = tmp_path / "out"
+    done = run_cli("build", str(spec), "-o", str(out), "--picture", "off")
+    assert done.returncode == 0, done.stderr[-2000:]
+    assert "warning: posed skin: posed.folds =" in done.stdout
+    report = json.loads((out / "hopper-squash-core" / "build-report.json").read_text())
+    posed = {g["name"]: g for g in report["surface"]["posedGates"]}
+    assert set(posed) == {"posed.inverted", "posed.folds", "posed.selfIntersections"}
+    assert not posed["posed.folds"]["passed"]
+    refused = tmp_path / "refused"
+    done = run_cli("build", str(spec), "-o", str(refused), "--picture", "off", "--posed-gates", "refuse")
+    assert done.returncode == 3, done.stderr[-2000:]
+    assert f"{spec}: surface.hero.posed: gate posed.folds" in done.stderr
+    assert "part.counter-tail" in done.stderr
+    assert "worst in the envelope pose '" in done.stderr
+    assert "Traceback" not in done.stderr
+    assert not refused.exists()
+
+
 def test_population_short_of_n_identities_exits_3(
     tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
 ) -> None:

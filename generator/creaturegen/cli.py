@@ -36,7 +36,14 @@ from .spec.schema import stale_schemas, write_schemas
 from .spec.summary import summarize
 from .surface.asset import SurfaceCache
 from .surface.backends import BACKENDS, BackendChoiceError
-from .surface.build import DEFAULT_TIER, SurfaceBuild, SurfaceRejectedError, build_surface
+from .surface.build import (
+    DEFAULT_TIER,
+    SurfaceBuild,
+    SurfaceRejectedError,
+    build_surface,
+    posed_failures,
+    posed_refusal,
+)
 from .surface.deform import DeformationError
 from .surface.grid import GridTooFineError
 
@@ -189,6 +196,15 @@ def _identity(args: argparse.Namespace, name: str, spec: CharacterSpec, data: by
     if isinstance(build, int):
         return build
     _print_gates(build)
+    failed = posed_failures(build.sidecar)
+    if failed and args.posed_gates == "refuse":
+        print_errors(name, [SpecError(f"surface.{args.tier}.posed", posed_refusal(failed))])
+        return EXIT_REFUSED
+    for gate in failed:
+        print(
+            f"  warning: posed skin: {gate.name} = {gate.value:g} {gate.unit} ({gate.detail}); recorded in "
+            "assets/surface.json, not enforced (--posed-gates refuse refuses the build)"
+        )
     counts = build.sidecar["counts"]
     print(f"  mesh {counts}; " + ("cache hit" if build.cached else "extracted"))
     return _Identity(name, spec, data, rig, build)
@@ -533,6 +549,14 @@ def build_parser() -> argparse.ArgumentParser:
         choices=("auto", "on", "off"),
         help="creature packages: render the README picture in the lab before committing the package "
         "(auto: when Chromium and web_lab/node_modules are there; default $CREATUREGEN_PICTURE or auto)",
+    )
+    build.add_argument(
+        "--posed-gates",
+        default="report",
+        choices=("report", "refuse"),
+        help="creature specs: what a visible flip, fold or crossing of the skin at a pose of the motion "
+        "envelope does (surface/posed.py): report it (default; recorded in the package's surface.json "
+        "and printed) or refuse the build, naming the parts and the pose",
     )
     build.add_argument(
         "--population",

@@ -148,6 +148,8 @@ def run_job(job: Job, packages: Path, timeout: float = BUILD_TIMEOUT_S, workers:
         mesh = re.search(r"mesh \{'vertices': (\d+), 'triangles': (\d+)", stdout)
         if mesh:
             record["vertices"], record["triangles"] = int(mesh.group(1)), int(mesh.group(2))
+        # Posed-skin gates are reported, not enforced (surface/posed.py): the build prints each failure.
+        record["posedFailed"] = re.findall(r"warning: posed skin: (posed\.\w+) =", stdout)
     else:
         record.update(parse_refusal(stderr))
         if status == "error":
@@ -194,6 +196,11 @@ def _summary(records: list[dict[str, Any]], tiers: Sequence[str]) -> dict[str, A
             "maxSeconds": times[-1] if times else 0.0,
             "refusalsNamingAPart": sum(1 for r in rows if r["status"] != "built" and r.get("parts")),
             "causes": dict(sorted(causes.items(), key=lambda kv: -kv[1])),
+            "builtFailingPosedGates": sum(1 for r in built if r.get("posedFailed")),
+            "posedFailures": {
+                g: sum(1 for r in built if g in r.get("posedFailed", []))
+                for g in ("posed.inverted", "posed.folds", "posed.selfIntersections")
+            },
         }
     return out
 
@@ -204,13 +211,16 @@ _STYLE = (
     ".card{background:#fff;border:1px solid #ddd;border-radius:6px;padding:8px}"
     ".card img,.none{width:192px;height:192px;display:block;margin:auto;background:#eef0f4}"
     ".name{font-weight:600;margin-top:4px}.meta{color:#666;font-size:11px;margin-bottom:4px}"
-    ".ok{color:#17662a}.no{color:#a11;cursor:help}"
+    ".ok{color:#17662a}.no{color:#a11;cursor:help}.warn{color:#8a5a00}"
 )
 
 
 def _badge(tier: str, record: dict[str, Any]) -> str:
     """One line per tier: status and time; a refusal names its gate and parts, the whole message on hover."""
     text = f"{tier}: {record['status']} {record['seconds']:.1f} s"
+    if record["status"] == "built" and record.get("posedFailed"):
+        posed = ", ".join(g.removeprefix("posed.") for g in record["posedFailed"])
+        return f'<div class="warn">{html.escape(text)} — posed skin: {html.escape(posed)}</div>'
     if record["status"] == "built":
         return f'<div class="ok">{html.escape(text)}</div>'
     named = " ".join(x for x in (record.get("gate", ""), ", ".join(record.get("parts", []))) if x)

@@ -32,11 +32,22 @@ def build_report(plan: dict[str, Any], surface: SurfaceBuild) -> dict[str, Any]:
         "methods": plan["methods"],
         "debugModes": plan["runtime"]["debugModes"],
         "candidateNote": plan["runtime"]["candidateNote"],
-        "surface": {"passed": surface.passed, "counts": surface.sidecar.get("counts")},
+        "surface": {
+            "passed": surface.passed,
+            "counts": surface.sidecar.get("counts"),
+            # Recorded, not enforced (surface/posed.py; `creaturegen build --posed-gates refuse`).
+            "posedGates": _posed_rows(surface.sidecar),
+        },
         # Where the package's files are: Python tools read the asset path here (creature/assets.py).
         "assets": {"surface": plan["assets"]["surfacePath"], "spec": SPEC_PATH, "sidecar": SIDECAR_PATH},
         "gates": plan["gates"],
     }
+
+
+def _posed_rows(sidecar: dict[str, Any]) -> list[Any]:
+    posed = sidecar.get("posed")
+    rows = posed.get("gates", []) if isinstance(posed, dict) else []
+    return list(rows) if isinstance(rows, list) else []
 
 
 def creature_files(

@@ -54,6 +54,7 @@ from .gates import (
 from .grid import FIRST_CELLS_LIMIT, Grid, GridTooFineError, make_grid, tier_offset
 from .handles import certain_handle_possible, handle_contacts
 from .mesh import Mesh
+from .posed import choice_skinner, posed_gates, posed_quality
 from .sampling import sample_band
 from .skeleton import Skeleton, build_skeleton
 from .skin_tier import (
@@ -88,6 +89,13 @@ MIN_ANGLE_P1_DEG = 15.0
 #: The skin alone must stay within this fraction of L of the posed field over the sweep; vertices that do
 #: not are the correction region.
 SKIN_ERROR_FACTOR = DISTANCE_TOL
+#: What a refusal of the posed skin (surface/posed.py) tells the user: the motion carries a limb's skin
+#: into a fold or through another sheet where the body has none.
+POSED_REMEDY = (
+    "; the motion presses this skin into itself at that pose: a smaller turn there (a shorter step or hop, "
+    "a gentler slope run), a thinner limb at its joint, or more room between the limb and the part it "
+    "swings against keeps the skin clear"
+)
 #: Mesh-normal maxima (degrees): a blend fillet narrower than a few lattice cells turns the true normal
 #: faster than a triangle can follow, so the worst vertex sits well above the bulk (the p99 gates of
 #: surface/gates.py stay at 5° and 10°). Shading uses the analytic normals stored per vertex, not these.
@@ -400,6 +408,25 @@ def runtime_skin(
     method = deform.vertex_methods(indices, weights, choice.methods, skeleton).astype(np.float64)
     radius = np.where(region & (programs != NO_PROGRAM), trust, 0.0)
     return np.stack([method, radius], axis=1).astype(np.float32)
+
+
+def posed_failures(sidecar: dict[str, object]) -> list[SurfaceGate]:
+    """The posed-skin gates (surface/posed.py) a build failed, read back from its sidecar (cache hits
+    included). They are recorded, not enforced: the caller decides (``creaturegen build --posed-gates``)."""
+    posed = sidecar.get("posed")
+    rows = posed.get("gates", []) if isinstance(posed, dict) else []
+    gates = [_gate_from_row(g) for g in rows if isinstance(g, dict)]
+    return [g for g in gates if not g.passed]
+
+
+def posed_refusal(failed: list[SurfaceGate]) -> str:
+    """A refusal naming the first failed posed gate (its detail names the parts and the pose)."""
+    g = failed[0]
+    more = f" (also failed: {', '.join(f.name for f in failed[1:])})" if len(failed) > 1 else ""
+    return (
+        f"gate {g.name} = {g.value:.4g} {g.unit}, threshold {g.threshold:.4g} ({g.direction}): "
+        f"{g.detail}{more}{POSED_REMEDY}"
+    )
 
 
 def _fail_on(gates: list[SurfaceGate], where: str, remedy: str = "") -> None:
@@ -1138,6 +1165,27 @@ def _extract_with(
     if strict:
         _fail_on(correction_gates, f"surface {tier} correction")
 
+    t = time.perf_counter()
+    pair = (weights.indices, weights.weights)
+    quality = posed_quality(
+        rig,
+        mesh,
+        pair,
+        choice_skinner(mesh, ex.normals, pair, skeleton, choice),
+        np.where(region & (programs != NO_PROGRAM), trust, 0.0),
+        envelope.poses,
+        envelope.pose_labels,
+    )
+    names = skeleton.names
+    posed = posed_gates(quality, [names[s] for s in weights.indices[mesh.faces[:, 0], 0]])
+    timings["posed"] = time.perf_counter() - t
+    creases = max((p.creases for p in quality.poses), default=0)
+    progress(
+        f"posed skin over {len(quality.poses)} envelope poses: "
+        + ", ".join(f"{g.name.removeprefix('posed.')} {g.value:g}" for g in posed)
+        + f" (visible creases along the parts' hard union: {creases}) in {timings['posed']:.2f} s"
+    )
+
     from .frames import radial_coordinates, rest_frames
 
     frames = rest_frames(rig, skeleton)
@@ -1202,6 +1250,7 @@ def _extract_with(
             "skinOnlyError": worst_skin,
             "candidateNote": candidate_note,
         },
+        "posed": {**quality.describe(), "gates": [g.as_dict() for g in posed]},
         "gates": [g.as_dict() for g in gates],
         "timings": timings,
     }

@@ -768,7 +768,7 @@ def _triple(c: F64) -> F64:
     return result
 
 
-def _edge_faces(faces: I64) -> I64:
+def edge_faces(faces: I64) -> I64:
     """(E, 2) the two faces of each edge used by exactly two: the pairs whose crease the folds measure."""
     table = topology.edge_table(faces)
     order = np.argsort(table.edge_of_half, kind="stable")
@@ -1192,15 +1192,15 @@ def choose_deformation(
     corners = mesh.vertices[faces]
     triple = _triple(corners)
     face_normals = unit_rows(np.cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0]))
-    edge_faces = _edge_faces(faces)
+    pairs = edge_faces(faces)
     rest = _Rest(
         vertices=mesh.vertices,
         faces=faces,
         triple=triple,
         volume=float(triple.sum()) / 6.0,
         face_normals=face_normals,
-        edge_faces=edge_faces,
-        rest_dihedral=angles_deg(face_normals[edge_faces[:, 0]], face_normals[edge_faces[:, 1]]),
+        edge_faces=pairs,
+        rest_dihedral=angles_deg(face_normals[pairs[:, 0]], face_normals[pairs[:, 1]]),
         centers=centers if centers is not None else centers_of_rotation(mesh, idx, w),
     )
     methods: list[Method] = ["lbs"] * len(skeleton.parent)

@@ -119,6 +119,29 @@ def build_bvh(lo: F64, hi: F64, leaf_size: int = 4) -> BVH:
     return BVH(depth, node_lo, node_hi, leaves.astype(np.int64), lo, hi)
 
 
+def refit(bvh: BVH, lo: F64, hi: F64) -> BVH:
+    """The same tree over moved primitives (new boxes ``lo``/``hi``, same ids): each node's box
+    recomputed bottom-up. A deformation that keeps neighbours together (a skinned pose) keeps the tree
+    tight, at the cost of a few reductions instead of a rebuild's argsort per level."""
+    valid = bvh.leaves >= 0
+    safe = np.where(valid, bvh.leaves, 0)
+    node_lo = np.empty_like(bvh.lo)
+    node_hi = np.empty_like(bvh.hi)
+    first = (1 << bvh.depth) - 1
+    node_lo[first:] = np.where(valid[:, :, None], lo[safe], np.inf).min(axis=1)
+    node_hi[first:] = np.where(valid[:, :, None], hi[safe], -np.inf).max(axis=1)
+    for d in range(bvh.depth - 1, -1, -1):
+        parents = np.arange((1 << d) - 1, (1 << (d + 1)) - 1)
+        node_lo[parents] = np.minimum(node_lo[2 * parents + 1], node_lo[2 * parents + 2])
+        node_hi[parents] = np.maximum(node_hi[2 * parents + 1], node_hi[2 * parents + 2])
+    return BVH(bvh.depth, node_lo, node_hi, bvh.leaves, lo, hi)
+
+
+def triangle_boxes(corners: F64) -> tuple[F64, F64]:
+    """(F, 3) lower and upper corners of each triangle's box."""
+    return corners.min(axis=1), corners.max(axis=1)
+
+
 def triangle_bvh(mesh: Mesh, leaf_size: int = 4) -> BVH:
     c = mesh.corners()
     lo = np.minimum(np.minimum(c[:, 0], c[:, 1]), c[:, 2])
@@ -156,10 +179,20 @@ def overlapping_leaf_pairs(bvh: BVH) -> tuple[I64, I64]:
     return a, b
 
 
-def candidate_pairs(bvh: BVH, faces: npt.NDArray[np.integer]) -> Iterator[tuple[I64, I64]]:
+def candidate_pairs(
+    bvh: BVH, faces: npt.NDArray[np.integer], groups: I64 | None = None
+) -> Iterator[tuple[I64, I64]]:
     """Batches of face pairs (i, j), each unordered pair once, whose AABBs overlap and that share no
-    vertex index."""
+    vertex index. With ``groups`` (F,), pairs of faces in one group ≥ 0 are left out, whole leaf pairs
+    first: faces a pose moved together (surface/posed.py)."""
     la, lb = overlapping_leaf_pairs(bvh)
+    if groups is not None:
+        leaf_group = np.where(bvh.leaves >= 0, groups[np.maximum(bvh.leaves, 0)], -2)
+        one = np.where(
+            np.all((leaf_group == leaf_group[:, :1]) | (leaf_group == -2), axis=1), leaf_group[:, 0], -1
+        )
+        keep = (one[la] < 0) | (one[la] != one[lb])
+        la, lb = la[keep], lb[keep]
     m = bvh.leaves.shape[1]
     f = np.asarray(faces, dtype=np.int64)
     lo, hi = np.ascontiguousarray(bvh.prim_lo.T).T, np.ascontiguousarray(bvh.prim_hi.T).T
@@ -174,7 +207,11 @@ def candidate_pairs(bvh: BVH, faces: npt.NDArray[np.integer]) -> Iterator[tuple[
             i = bvh.leaves[leaf_a[s : s + LEAF_PAIR_CHUNK]][:, si].reshape(-1)
             j = bvh.leaves[leaf_b[s : s + LEAF_PAIR_CHUNK]][:, sj].reshape(-1)
             ok = (i >= 0) & (j >= 0)
-            i, j = _overlapping(lo, hi, i[ok], j[ok])
+            i, j = i[ok], j[ok]
+            if groups is not None:
+                apart = (groups[i] < 0) | (groups[i] != groups[j])
+                i, j = i[apart], j[apart]
+            i, j = _overlapping(lo, hi, i, j)
             fi, fj = f[i], f[j]
             shared = np.zeros(i.size, dtype=bool)
             for u in range(3):
