@@ -47,6 +47,7 @@ from typing import Any, Final
 import numpy as np
 import numpy.typing as npt
 
+from ..codedigest import stage_digest
 from ..creature.genome import MAX_GAIT_GENES, Genome, express
 from ..creature.pose import instance_yaw
 from ..field import layout as col
@@ -54,7 +55,6 @@ from ..rig import CompiledRig
 from ..spec import CharacterSpec
 from ..surface.asset import default_cache_root
 from ..surface.deform import Pose, joint_frame, quaternion_multiply, quaternion_to_matrix
-from ..surface.identity import source_digest
 from ..surface.skeleton import Skeleton, build_skeleton
 from .derived import MotionRangeError, derive
 from .providers import AnalyticWater, FlatGround, Gravity, Support, builtin_supports
@@ -539,7 +539,9 @@ def start_pose_envelope(spec: CharacterSpec, rig: CompiledRig) -> PendingEnvelop
     skeleton = build_skeleton(spec, rig)
     data = build_motion(spec, rig, skeleton)
     key = hashlib.sha256(
-        json.dumps(data, sort_keys=True).encode() + rig.slots.tobytes() + source_digest().encode()
+        json.dumps(data, sort_keys=True).encode()
+        + rig.slots.tobytes()
+        + stage_digest("creaturegen.motion.envelope").encode()
     ).hexdigest()
     if key in _MEMORY:
         return PendingEnvelope(key, _MEMORY[key])

@@ -14,12 +14,11 @@ from __future__ import annotations
 
 import hashlib
 import json
-from functools import cache
-from pathlib import Path
 
 import numpy as np
 import numpy.typing as npt
 
+from ..codedigest import stage_digest
 from ..rig import CompiledRig
 from ..rig.signatures import Signatures, compiler_description, signatures, topology_description
 from . import correct, extract, grid, sampling
@@ -54,20 +53,15 @@ def surface_settings(tier: str) -> dict[str, object]:
     }
 
 
-#: Packages whose code shapes the surface: any edit to them is a different compiler, so a stale cache
-#: entry is never served while the version number stands still during development.
-SOURCE_PACKAGES = ("surface", "field", "rig", "candidates", "motion", "creature")
+#: The module whose import closure is the surface stage's code (codedigest.py): any edit to a statement
+#: it runs is a different compiler, so a stale cache entry is never served while the version number
+#: stands still during development; an edit elsewhere, or to prose, keeps the cache.
+SURFACE_ENTRY = "creaturegen.surface.build"
 
 
-@cache
 def source_digest() -> str:
-    root = Path(__file__).resolve().parent.parent
-    h = hashlib.sha256()
-    for package in SOURCE_PACKAGES:
-        for path in sorted((root / package).glob("*.py")):
-            h.update(f"{package}/{path.name}".encode())
-            h.update(path.read_bytes())
-    return h.hexdigest()
+    """The digest of the surface stage's code (see SURFACE_ENTRY)."""
+    return stage_digest(SURFACE_ENTRY)
 
 
 def settings_digest(tier: str, extra: dict[str, object]) -> str:

@@ -103,7 +103,6 @@ class PosedQuality:
             "faces": self.faces,
             "foldDeg": FOLD_DEG,
             "bandTolerance": BAND_TOL,
-            "seconds": round(self.seconds, 3),
             "poses": [
                 {
                     "label": p.label,

@@ -1,0 +1,73 @@
+"""The digest of a stage's code (codedigest.py): what it covers, and that prose never counts while code
+does, checked on a copy of the package edited three ways."""
+
+from __future__ import annotations
+
+import shutil
+from pathlib import Path
+
+import pytest
+
+from creaturegen.codedigest import PACKAGE_ROOT, code_closure, code_digest
+from creaturegen.surface.identity import SURFACE_ENTRY
+
+ENVELOPE = "creaturegen.motion.envelope"
+
+
+@pytest.fixture
+def copy(tmp_path: Path) -> Path:
+    root = tmp_path / "creaturegen"
+    shutil.copytree(PACKAGE_ROOT, root, ignore=shutil.ignore_patterns("__pycache__", "templates", "web_lab"))
+    return root
+
+
+def test_the_surface_runs_its_own_closure_and_not_the_package_writer_or_the_lab() -> None:
+    closure = set(code_closure(SURFACE_ENTRY))
+    assert {
+        "creaturegen.surface.build",
+        "creaturegen.surface.posed",  # imported by build
+        "creaturegen.surface.frames",  # imported inside a function
+        "creaturegen.motion.envelope",
+        "creaturegen.creature.genome",
+        "creaturegen.field",  # a package's __init__ runs before its modules
+    } <= closure
+    for outside in ("creaturegen.creature.picture", "creaturegen.creature.build", "creaturegen.cli"):
+        assert outside not in closure
+    assert not any(
+        m.startswith(("creaturegen.lab", "creaturegen.emit", "creaturegen.frost")) for m in closure
+    )
+    assert set(code_closure(ENVELOPE)) < closure
+
+
+def _edit(path: Path, old: str, new: str) -> None:
+    text = path.read_text()
+    assert old in text, f"{old!r} not in {path}"
+    path.write_text(text.replace(old, new, 1))
+
+
+def test_prose_keeps_the_digest_and_code_changes_it(copy: Path) -> None:
+    before = {e: code_digest(e, copy) for e in (SURFACE_ENTRY, ENVELOPE)}
+    genome = copy / "creature" / "genome.py"
+    # A comment, a docstring and a blank line in a module both stages run: nothing changes.
+    _edit(genome, "HUE_DRAW: Final = 3", "# a comment\n\nHUE_DRAW: Final = 3  # and another")
+    text = genome.read_text()
+    start = text.index('"""') + 3
+    genome.write_text(text[:start] + "Reworded. " + text[start:])
+    # Code in a module neither stage imports: nothing changes.
+    _edit(
+        copy / "creature" / "picture.py",
+        "from __future__ import annotations",
+        "from __future__ import annotations\nX = 1",
+    )
+    assert {e: code_digest(e, copy) for e in before} == before
+    # One constant in a module both run: both change.
+    _edit(genome, "HUE_DRAW: Final = 3", "HUE_DRAW: Final = 4")
+    after = {e: code_digest(e, copy) for e in before}
+    assert all(after[e] != before[e] for e in before)
+
+
+def test_a_module_only_the_surface_runs_keeps_the_envelope_digest(copy: Path) -> None:
+    before = {e: code_digest(e, copy) for e in (SURFACE_ENTRY, ENVELOPE)}
+    _edit(copy / "surface" / "posed.py", "FOLD_DEG: Final = 90.0", "FOLD_DEG: Final = 91.0")
+    assert code_digest(SURFACE_ENTRY, copy) != before[SURFACE_ENTRY]
+    assert code_digest(ENVELOPE, copy) == before[ENVELOPE]
