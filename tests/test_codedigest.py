@@ -31,7 +31,7 @@ def test_the_surface_runs_its_own_closure_and_not_the_package_writer_or_the_lab(
         "creaturegen.creature.genome",
         "creaturegen.field",  # a package's __init__ runs before its modules
     } <= closure
-    for outside in ("creaturegen.creature.picture", "creaturegen.creature.build", "creaturegen.cli"):
+    for outside in ("creaturegen.lab.picture", "creaturegen.creature.build", "creaturegen.cli"):
         assert outside not in closure
     assert not any(
         m.startswith(("creaturegen.lab", "creaturegen.emit", "creaturegen.frost")) for m in closure
@@ -55,7 +55,7 @@ def test_prose_keeps_the_digest_and_code_changes_it(copy: Path) -> None:
     genome.write_text(text[:start] + "Reworded. " + text[start:])
     # Code in a module neither stage imports: nothing changes.
     _edit(
-        copy / "creature" / "picture.py",
+        copy / "lab" / "picture.py",
         "from __future__ import annotations",
         "from __future__ import annotations\nX = 1",
     )

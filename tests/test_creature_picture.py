@@ -17,7 +17,7 @@ import numpy as np
 import pytest
 
 from conftest import EXAMPLES, REPO, run_cli
-from creaturegen.creature.picture import PICTURE_PATH, PICTURE_SIZE
+from creaturegen.lab.picture import PICTURE_PATH, PICTURE_SIZE
 from creaturegen.spec import slugify
 
 HOPPER = EXAMPLES / "reference" / "hopper.json"

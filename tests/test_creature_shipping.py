@@ -731,8 +731,7 @@ def test_readme_links_resolve_inside_the_package(hopper: Path, tmp_path: Path) -
 
 def test_files_list_the_picture_the_readme_shows() -> None:
     """With a picture the README shows assets/preview.png, so `files` must list it; without, it must not."""
-    from creaturegen.creature.assets import shipped_files
-    from creaturegen.creature.picture import PICTURE_PATH
+    from creaturegen.creature.assets import PICTURE_PATH, shipped_files
 
     assert PICTURE_PATH in shipped_files("assets/x-0123456789ab.glb", PICTURE_PATH)
     assert PICTURE_PATH not in shipped_files("assets/x-0123456789ab.glb", None)

@@ -22,13 +22,14 @@ import numpy as np
 
 from . import __version__
 from .candidates import TIERS, describe_candidates
+from .creature.assets import PICTURE_PATH
 from .creature.build import build_creature
 from .creature.morphology import identity_genes, variant_bytes
-from .creature.picture import PICTURE_PATH, picture_unavailable
 from .emit import PackageWriteError
 from .field.sampler import sample
 from .frost.build import build_frost
 from .frost.formats import FormatRefusedError
+from .lab.picture import picture_unavailable, render_picture
 from .rig import CompiledRig, RigCompileError, compile_rig
 from .rig.report import describe_rig
 from .spec import CharacterSpec, SpecError, SpecValidationError, load_spec, slugify, validate_bytes
@@ -278,7 +279,8 @@ def _build_creature(args: argparse.Namespace, spec: CharacterSpec, data: bytes) 
         print(f"==> picture: {PICTURE_PATH} rendered by the lab (headless Chromium, WebGPU on SwiftShader)")
     for one in identities:
         try:
-            folder = build_creature(one.spec, one.rig, one.data, one.build, Path(args.out), picture=picture)
+            render = render_picture if picture else None
+            folder = build_creature(one.spec, one.rig, one.data, one.build, Path(args.out), render)
         except PackageWriteError as exc:
             print(f"{one.name}: cannot write the package: {exc}", file=sys.stderr)
             return EXIT_INVALID

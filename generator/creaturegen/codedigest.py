@@ -1,8 +1,8 @@
 """The digest of the code a stage runs: the modules its entry imports, transitively, without their prose.
 
 A cache keyed by the compiler's code must change when that code changes and only then. Hashing whole
-packages made a docstring edit in ``creature/picture.py`` (which no surface build runs) change every
-compilerSignature, empty the surface cache and break the golden record. Here a stage names its entry
+packages made a docstring edit in the README picture's module (which no surface build runs) change
+every compilerSignature, empty the surface cache and break the golden record. Here a stage names its entry
 module; the digest covers the creaturegen modules reachable from it through ``import`` statements
 anywhere in their text (module level or inside functions), each parsed and dumped without docstrings,
 so comments, docstrings and formatting never count while every statement, constant and name does.

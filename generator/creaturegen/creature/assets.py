@@ -21,6 +21,8 @@ SPEC_PATH = f"{ASSET_DIR}/spec.json"
 SIDECAR_PATH = f"{ASSET_DIR}/surface.json"
 #: The build report: diagnostics beside the package, not part of what npm publishes.
 REPORT_PATH = "build-report.json"
+#: The README picture (rendered by the lab, lab/picture.py), shipped when the build made one.
+PICTURE_PATH = f"{ASSET_DIR}/preview.png"
 #: Hex digits of the geometryDigest in the asset's name: 48 bits, unique across any realistic site.
 DIGEST_DIGITS = 12
 

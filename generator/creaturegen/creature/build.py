@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import hashlib
+from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
@@ -13,8 +14,7 @@ from ..spec import CharacterSpec, slugify
 from ..surface.asset import glb_bytes, sidecar_bytes
 from ..surface.build import SurfaceBuild
 from ..surface.emit import stable_sidecar
-from .assets import REPORT_PATH, SIDECAR_PATH, SPEC_PATH, shipped_files, shipped_spec
-from .picture import PICTURE_PATH, render_picture
+from .assets import PICTURE_PATH, REPORT_PATH, SIDECAR_PATH, SPEC_PATH, shipped_files, shipped_spec
 from .plan import build_plan
 
 
@@ -70,19 +70,27 @@ def creature_files(
     return files
 
 
+#: Renders a staged package folder (not yet committed) to the README picture's PNG bytes.
+PictureRenderer = Callable[[Path], bytes]
+
+
 def build_creature(
     spec: CharacterSpec,
     rig: CompiledRig,
     spec_bytes: bytes,
     surface: SurfaceBuild,
     out_root: Path,
-    picture: bool = False,
+    render: PictureRenderer | None = None,
 ) -> Path:
-    """Write the package and return its folder. With ``picture`` the staged package is rendered by the lab
-    into PICTURE_PATH before it is committed. Nothing is written if any step raises."""
-    files = creature_files(spec, rig, spec_bytes, surface, picture)
+    """Write the package and return its folder. With ``render`` (the lab's, lab/picture.py, handed in by
+    the command line) the staged package is rendered into PICTURE_PATH before it is committed. Nothing
+    is written if any step raises."""
+    files = creature_files(spec, rig, spec_bytes, surface, render is not None)
+    if render is None:
+        return write_package(out_root, slugify(spec.name), files, None)
+    draw = render
 
     def add_picture(staging: Path) -> list[PackageFile]:
-        return [PackageFile(PICTURE_PATH, render_picture(staging))]
+        return [PackageFile(PICTURE_PATH, draw(staging))]
 
-    return write_package(out_root, slugify(spec.name), files, add_picture if picture else None)
+    return write_package(out_root, slugify(spec.name), files, add_picture)

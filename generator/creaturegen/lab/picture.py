@@ -3,6 +3,8 @@ WebGPU on SwiftShader) and read back from a render target, before the package fo
 
 It is part of the build, so a build with the picture needs the lab (Chromium, Playwright and three from npm).
 ``picture_unavailable`` says why it cannot run here, so ``--picture auto`` can build without it and say so.
+The command line hands ``render_picture`` to the package writer (creature/build.py), which never imports
+the lab: the lab runs packages, it is not part of making one.
 """
 
 from __future__ import annotations
@@ -12,10 +14,12 @@ from pathlib import Path
 
 import numpy as np
 
-from ..lab.png import encode_png
+from ..creature.assets import PICTURE_PATH
+from .png import encode_png
 
-#: The README picture's path inside the package, and its size (pixels).
-PICTURE_PATH = "assets/preview.png"
+__all__ = ["PICTURE_PATH", "PICTURE_SIZE", "picture_unavailable", "render_picture"]
+
+#: The README picture's size (pixels); its path in the package is the package layout's (PICTURE_PATH).
 PICTURE_SIZE = (480, 320)
 #: The tick and seed it shows (the parity job's pose, so the picture is the body the gates measured).
 PICTURE_TICK = 37
@@ -29,7 +33,7 @@ def picture_unavailable() -> str | None:
     missing = playwright_missing()
     if missing is not None:
         return missing
-    from ..lab.browser import find_chromium
+    from .browser import find_chromium
 
     try:
         lab_modules(install=True)
@@ -41,7 +45,7 @@ def picture_unavailable() -> str | None:
 
 def render_picture(package: Path) -> bytes:
     """PNG bytes of body 0 of ``package`` (a package folder, possibly not yet committed) in the lab."""
-    from ..lab.creature_parity import open_creature_lab
+    from .creature_parity import open_creature_lab
 
     with open_creature_lab(package, PICTURE_SIZE, seed=PICTURE_SEED, capacity=1, pageSize=1) as page:
         page.evaluate(f"() => window.__lab.seekTick({PICTURE_TICK})")
