@@ -37,13 +37,13 @@ import numpy.typing as npt
 
 from benchlib import machine
 from creaturegen.candidates import build_candidates, tolerances
-from creaturegen.field import layout as col
 from creaturegen.field.colour import proximity_colour
 from creaturegen.field.floors import floors_for
 from creaturegen.field.primitives import primitive_distance
 from creaturegen.field.sampler import evaluate_distance, sample_distance, sample_graph
+from creaturegen.model import layout as col
+from creaturegen.model.graph import BlendGraph
 from creaturegen.rig import CompiledRig, compile_rig
-from creaturegen.rig.graph import BlendGraph
 from creaturegen.spec import CharacterSpec, load_spec
 
 REPO = Path(__file__).resolve().parents[1]

@@ -48,6 +48,7 @@ import numpy as np
 import numpy.typing as npt
 
 from benchlib import machine
+from creaturegen.model.skeleton import Skeleton, build_skeleton
 from creaturegen.rig import CompiledRig, compile_rig
 from creaturegen.spec import CharacterSpec, load_spec
 from creaturegen.surface.backends import BackendUnavailableError, FieldBackend, NumpyBackend, make_backend
@@ -58,7 +59,6 @@ from creaturegen.surface.field64 import BodyField
 from creaturegen.surface.gates import SurfaceGate
 from creaturegen.surface.grid import ERROR_TARGET, Grid, GridTooFineError, make_grid, smallest_radius
 from creaturegen.surface.sampling import SIGN_SETTLE_FACTOR, NarrowBand, sample_band
-from creaturegen.surface.skeleton import Skeleton, build_skeleton
 
 T = TypeVar("T")
 

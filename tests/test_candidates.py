@@ -15,10 +15,10 @@ from creaturegen.candidates.program import build_program
 from creaturegen.candidates.regions import RegionSearch, Tier, search
 from creaturegen.field.floors import floors_for
 from creaturegen.field.sampler import sample_graph
+from creaturegen.model.rotations import posed_slots
 from creaturegen.motion.envelope import pose_envelope
 from creaturegen.rig import CompiledRig, compile_rig
 from creaturegen.spec import CharacterSpec, load_spec
-from creaturegen.surface.deform import posed_slots
 
 CREATURES = [p for p in sorted(EXAMPLES.rglob("*.json")) if "frost" not in p.parts]
 
@@ -154,8 +154,8 @@ def _two_leaf_colour(colour_b: tuple[float, float, float], gap: float) -> tuple[
     the kept upper bound (k = 0.1, so the omitted weight is e^(−gap/0.1))."""
     from creaturegen.candidates.bounds import LeafBounds, subtree_info
     from creaturegen.candidates.program import _colour_certificate
-    from creaturegen.field import layout as col
-    from creaturegen.rig.graph import BlendGraph
+    from creaturegen.model import layout as col
+    from creaturegen.model.graph import BlendGraph
 
     slots = np.zeros((2, col.WIDTH))
     slots[:, col.RA] = slots[:, col.RB] = 0.1

@@ -24,18 +24,18 @@ from conftest import EXAMPLES, REPO, node, run_cli, run_node_tests
 from creaturegen import __version__, cli
 from creaturegen.creature import pose as pose_module
 from creaturegen.creature.assets import shipped_spec, surface_path
-from creaturegen.creature.genome import draw_genome, genetics_data, genome_colours, slot_lab
 from creaturegen.emit.lint import Finding, lint_package, lint_sources, shipped_sources
 from creaturegen.emit.render import to_json
 from creaturegen.emit.writer import header_text
-from creaturegen.field import layout as col
 from creaturegen.field.primitives import slot_uses_round_cone
+from creaturegen.model import layout as col
+from creaturegen.model.genome import draw_genome, genetics_data, genome_colours, slot_lab
+from creaturegen.model.skeleton import build_skeleton
 from creaturegen.motion.providers import AnalyticWater
 from creaturegen.motion.rig import build_motion
 from creaturegen.motion.simulate import Motion
 from creaturegen.rig import compile_rig
 from creaturegen.spec import CharacterSpec, load_spec, slugify
-from creaturegen.surface.skeleton import build_skeleton
 
 HOPPER = EXAMPLES / "reference" / "hopper.json"
 HOPPER_SLUG = "hopper-squash-core"
@@ -424,7 +424,7 @@ def python_reference(spec_path: Path) -> dict[str, Any]:
     for seed in SEEDS:
         state, draws = seed % (1 << 32), []
         for _ in range(LCG_DRAWS):
-            state = pose_module.lcg_next(state)
+            state = lcg.lcg_next(state)
             draws.append(state)
         lcg.append({"seed": seed, "draws": draws})
     cases = []
@@ -447,13 +447,12 @@ def python_reference(spec_path: Path) -> dict[str, Any]:
         "slotCount": rig.slot_count,
         "constants": {
             "poseRows": pose_module.POSE_ROWS,
-            "lcg": {"a": pose_module.LCG_A, "c": pose_module.LCG_C},
+            "lcg": {"a": lcg.LCG_A, "c": lcg.LCG_C},
             "roundCone": [int(x) for x in slot_uses_round_cone(rig.slots)],
         },
         "lcg": lcg,
         "instances": [
-            {"seed": seed, "mixed": pose_module.mix_seed(seed), "yaw": pose_module.instance_yaw(seed)}
-            for seed in SEEDS
+            {"seed": seed, "mixed": lcg.mix_seed(seed), "yaw": lcg.instance_yaw(seed)} for seed in SEEDS
         ],
         "cases": cases,
         "frameCount": sum(len(c["frames"]) for c in cases),

@@ -33,13 +33,13 @@ from creaturegen.creature.assets import (
     surface_path,
 )
 from creaturegen.emit.lint import lint_sources
+from creaturegen.model.skeleton import build_skeleton
 from creaturegen.motion.rig import build_motion
 from creaturegen.resources import lab_modules
 from creaturegen.rig import compile_rig
 from creaturegen.rig.signatures import signatures
 from creaturegen.spec import CharacterSpec, load_spec, slugify, validate_bytes
 from creaturegen.spec.character import LocomotionType
-from creaturegen.surface.skeleton import build_skeleton
 
 HOPPER = "reference/hopper.json"
 #: Examples whose motion data between them have legs, ropes and wings (the typed shapes of each).

@@ -43,11 +43,11 @@ import numpy.typing as npt
 import pytest
 
 from conftest import EXAMPLES
-from creaturegen.field import layout as col
 from creaturegen.field.primitives import GRADIENT_FLOOR, primitive_field, slot_uses_round_cone
 from creaturegen.field.sampler import evaluate_ops, sample
+from creaturegen.model import layout as col
+from creaturegen.model.graph import Ref
 from creaturegen.rig import CompiledRig, compile_rig
-from creaturegen.rig.graph import Ref
 from creaturegen.spec import CharacterSpec, validate_bytes
 
 Array = npt.NDArray[Any]

@@ -15,7 +15,6 @@ import numpy as np
 import numpy.typing as npt
 import pytest
 
-from creaturegen.field import layout
 from creaturegen.field.primitives import (
     TAPER_EXACT_THRESHOLD,
     primitive_field,
@@ -23,6 +22,7 @@ from creaturegen.field.primitives import (
     slot_uses_round_cone,
     tapered_capsule_field,
 )
+from creaturegen.model import layout
 
 Array = npt.NDArray[Any]
 

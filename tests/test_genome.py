@@ -16,7 +16,9 @@ import numpy as np
 import pytest
 
 from conftest import EXAMPLES, run_cli
-from creaturegen.creature.genome import (
+from creaturegen.creature.morphology import identity_genes, variant_document
+from creaturegen.model import layout as col
+from creaturegen.model.genome import (
     Genome,
     draw_genome,
     express_gait,
@@ -25,14 +27,12 @@ from creaturegen.creature.genome import (
     linear_from_oklab,
     slot_lab,
 )
-from creaturegen.creature.morphology import identity_genes, variant_document
-from creaturegen.field import layout as col
+from creaturegen.model.skeleton import build_skeleton
 from creaturegen.motion.rig import build_motion
 from creaturegen.rig import compile_rig
 from creaturegen.rig.colour import hex_to_linear
 from creaturegen.spec import CharacterSpec, SpecValidationError, load_spec, slugify, validate_bytes
 from creaturegen.spec.character import Genetics
-from creaturegen.surface.skeleton import build_skeleton
 
 SEEDS = range(256)
 #: Mid-gamut colours (no channel clips under the default bounds), so the OKLab bounds hold exactly.

@@ -11,13 +11,13 @@ from typing import Any
 
 import pytest
 
+from creaturegen.model.skeleton import build_skeleton
 from creaturegen.motion import quat as vq
 from creaturegen.motion.providers import builtin_supports, to_local, to_world
 from creaturegen.motion.rig import build_motion
 from creaturegen.motion.simulate import Motion
 from creaturegen.rig import compile_rig
 from creaturegen.spec import CharacterSpec, SpecValidationError, load_spec, validate_bytes
-from creaturegen.surface.skeleton import build_skeleton
 
 FIXTURES = Path(__file__).parent / "fixtures"
 KANGAROO = FIXTURES / "kangaroo.json"

@@ -1,12 +1,80 @@
-"""Import layering (issue 26): the package writer never reaches the lab. The lab runs built packages and
-renders their pictures; the command line hands the renderer to the writer (creature/build.py), so no
-module of creature/, nor anything it imports, imports lab/."""
+"""Import layering (issue 26): the packages of creaturegen in the order the data flows, each importing
+only from its own layer or below. spec → model (slot layout, blend graph, poses and rotations,
+skeleton, LCG and genome) → field → rig → motion → candidates → surface → creature (and frost) → lab →
+corpus → cli. Every import statement counts, at module level or inside a function, so a cycle cannot
+come back through a lazy import."""
 
 from __future__ import annotations
+
+import ast
 
 import pytest
 
 from creaturegen.codedigest import PACKAGE_ROOT, code_closure
+
+#: Lowest first. A package (or top-level module) may import from its own layer and the layers below.
+LAYERS: tuple[frozenset[str], ...] = (
+    frozenset({"spec", "cachedir", "codedigest", "resources"}),
+    frozenset({"model"}),
+    frozenset({"field"}),
+    frozenset({"rig"}),
+    frozenset({"motion", "emit"}),
+    frozenset({"candidates"}),
+    frozenset({"surface"}),
+    frozenset({"creature", "frost"}),
+    frozenset({"lab"}),
+    frozenset({"corpus"}),
+    frozenset({"cli", "__main__"}),
+)
+LEVEL = {name: i for i, layer in enumerate(LAYERS) for name in layer}
+
+
+def _unit(module: str) -> str:
+    """The layer unit of a creaturegen module: its subpackage, or the top-level module itself."""
+    parts = module.split(".")
+    return parts[1] if len(parts) > 1 else ""
+
+
+def _modules() -> list[tuple[str, ast.Module]]:
+    out = []
+    for path in sorted(PACKAGE_ROOT.rglob("*.py")):
+        rel = path.relative_to(PACKAGE_ROOT.parent).with_suffix("")
+        name = ".".join(rel.parts).removesuffix(".__init__")
+        out.append((name, ast.parse(path.read_text(encoding="utf-8"))))
+    return out
+
+
+def _imports(module: str, tree: ast.Module, is_package: bool) -> set[str]:
+    package = module if is_package else module.rpartition(".")[0]
+    found: set[str] = set()
+    for node in ast.walk(tree):
+        if isinstance(node, ast.ImportFrom):
+            if node.level:
+                base = package.split(".")[: len(package.split(".")) - (node.level - 1)]
+                found.add(".".join([*base, node.module] if node.module else base))
+            elif node.module:
+                found.add(node.module)
+        elif isinstance(node, ast.Import):
+            found.update(a.name for a in node.names)
+    return {m for m in found if m.split(".")[0] == "creaturegen"}
+
+
+def test_every_unit_has_a_layer() -> None:
+    units = {_unit(name) for name, _ in _modules()} - {""}
+    assert units <= set(LEVEL), f"give these a layer: {sorted(units - set(LEVEL))}"
+
+
+@pytest.mark.parametrize(("module", "tree"), _modules(), ids=lambda x: x if isinstance(x, str) else "")
+def test_no_module_imports_a_layer_above_its_own(module: str, tree: ast.Module) -> None:
+    unit = _unit(module)
+    if not unit:
+        return  # the package's __init__
+    is_package = (PACKAGE_ROOT.parent / module.replace(".", "/") / "__init__.py").is_file()
+    above = sorted(
+        m for m in _imports(module, tree, is_package) if _unit(m) and LEVEL[_unit(m)] > LEVEL[unit]
+    )
+    assert not above, f"{module} (layer {LEVEL[unit]}) imports from above: {above}"
+
 
 CREATURE_MODULES = sorted(
     f"creaturegen.creature.{p.stem}" for p in (PACKAGE_ROOT / "creature").glob("*.py") if p.stem != "__init__"
@@ -15,10 +83,13 @@ CREATURE_MODULES = sorted(
 
 @pytest.mark.parametrize("module", CREATURE_MODULES)
 def test_the_package_writer_does_not_reach_the_lab(module: str) -> None:
+    """The lab renders the README picture; the command line hands the renderer to the writer."""
     reached = sorted(m for m in code_closure(module) if m.startswith("creaturegen.lab"))
     assert not reached, f"{module} imports, directly or not, {reached}"
 
 
-def test_the_lab_still_builds_on_the_creature_package() -> None:
-    """The scan sees imports at all: the lab's parity job does import creature/."""
+def test_the_check_sees_imports_at_all() -> None:
+    """A planted upward import is caught: the scan reads function-level imports too."""
+    tree = ast.parse("def f():\n    from ..surface import build\n")
+    assert _imports("creaturegen.model.x", tree, False) == {"creaturegen.surface"}
     assert "creaturegen.creature.reference" in code_closure("creaturegen.lab.creature_parity")

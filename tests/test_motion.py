@@ -23,6 +23,7 @@ from conftest import (
     run_node_tests,
     spec_file,
 )
+from creaturegen.model.skeleton import build_skeleton
 from creaturegen.motion import quat as vq
 from creaturegen.motion.envelope import corner_genomes
 from creaturegen.motion.parity import motion_reference
@@ -40,7 +41,6 @@ from creaturegen.motion.simulate import Gates, Motion, TierRefusedError
 from creaturegen.rig import compile_rig
 from creaturegen.spec import CharacterSpec
 from creaturegen.spec.gate import load_spec, validate_bytes
-from creaturegen.surface.skeleton import build_skeleton
 
 TICKS = 1000
 #: The examples and the motion fixtures (the eight-legged spider, the kangaroo: a hopper on two legs): every

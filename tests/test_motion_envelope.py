@@ -11,7 +11,8 @@ import numpy as np
 import pytest
 
 from conftest import CREATURE_EXAMPLES, MOTION_FIXTURES, spec_file
-from creaturegen.field import layout as col
+from creaturegen.model import layout as col
+from creaturegen.model.skeleton import build_skeleton
 from creaturegen.motion import envelope
 from creaturegen.motion.providers import AnalyticWater
 from creaturegen.motion.rig import ROPE_BEND_LIMIT_DEG, build_motion
@@ -19,7 +20,6 @@ from creaturegen.motion.simulate import Motion
 from creaturegen.rig import compile_rig
 from creaturegen.spec import CharacterSpec
 from creaturegen.spec.gate import load_spec
-from creaturegen.surface.skeleton import build_skeleton
 
 #: Spawn seeds of the individuals checked against the envelope (none is a corner or a heading seed).
 RANDOM_SEEDS = (101, 2024, 77777)

@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 from conftest import EXAMPLES
-from creaturegen.field import layout as col
+from creaturegen.model import layout as col
 from creaturegen.rig import RigCompileError, compile_rig
 from creaturegen.rig.colour import srgb_channel_to_linear
 from creaturegen.spec import CharacterSpec, load_spec, validate_bytes

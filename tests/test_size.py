@@ -17,12 +17,12 @@ import pytest
 
 from conftest import build_example
 from creaturegen.creature import reference as cref
-from creaturegen.creature.genome import draw_genome, individual_size
 from creaturegen.creature.pose import as_pose, pose_rows
 from creaturegen.lab.creature_parity import LAB_SEED, PARITY_TICK
+from creaturegen.model.genome import draw_genome, individual_size
+from creaturegen.model.rotations import Pose
 from creaturegen.motion.providers import AnalyticWater
 from creaturegen.motion.simulate import Motion
-from creaturegen.surface.deform import Pose
 
 #: float64 agreement of the scaled body with the unit body scaled, relative to the body's length.
 SIMILAR = 1e-12

@@ -12,11 +12,11 @@ import pytest
 from conftest import EXAMPLES
 from creaturegen.candidates import TIERS
 from creaturegen.candidates.regions import SkinTolerance
-from creaturegen.field import layout as col
 from creaturegen.field.floors import floors_for
 from creaturegen.field.sampler import sample_graph
+from creaturegen.model import layout as col
+from creaturegen.model.graph import BlendGraph, Ref
 from creaturegen.rig import CompiledRig, compile_rig
-from creaturegen.rig.graph import BlendGraph, Ref
 from creaturegen.spec import CharacterSpec, load_spec
 from creaturegen.surface.asset import SurfaceAsset, glb_bytes, parse_glb
 from creaturegen.surface.build import SKIN_PROGRAM, SurfaceBuild, build_surface

@@ -15,6 +15,7 @@ import pytest
 
 from conftest import REPO, missing_setup
 from creaturegen import __version__
+from creaturegen.cachedir import default_cache_root
 from creaturegen.surface.asset import (
     ARRAY_BUFFER,
     ELEMENT_ARRAY_BUFFER,
@@ -23,7 +24,6 @@ from creaturegen.surface.asset import (
     GlbFormatError,
     SurfaceAsset,
     SurfaceCache,
-    default_cache_root,
     glb_bytes,
     parse_glb,
     read_glb,

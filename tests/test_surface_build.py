@@ -17,12 +17,12 @@ import pytest
 
 from conftest import CREATURE_EXAMPLES, EXAMPLES, REPO, rest_surface, run_cli
 from creaturegen.creature.assets import surface_path
+from creaturegen.model.skeleton import build_skeleton
 from creaturegen.rig import compile_rig
 from creaturegen.spec import CharacterSpec, load_spec
 from creaturegen.surface import build as surface_build
 from creaturegen.surface.asset import SurfaceCache, parse_glb
 from creaturegen.surface.build import SurfaceBuild, SurfaceRejectedError, build_surface
-from creaturegen.surface.skeleton import build_skeleton
 
 #: Parts the field itself leaves detached (rope or antenna anchored beyond the parent's surface).
 DETACHED = {

@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from conftest import EXAMPLES, rest_surface
-from creaturegen.field import layout as col
+from creaturegen.model import layout as col
 from creaturegen.surface.correct import DEFAULT_BUDGET, correct, trust_radius
 from creaturegen.surface.extract import Extraction
 from creaturegen.surface.field64 import BodyField

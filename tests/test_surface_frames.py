@@ -10,7 +10,8 @@ import numpy.typing as npt
 import pytest
 
 from conftest import EXAMPLES
-from creaturegen.field import layout as col
+from creaturegen.model import layout as col
+from creaturegen.model.skeleton import Skeleton, build_skeleton
 from creaturegen.rig import CompiledRig, compile_rig
 from creaturegen.spec import CharacterSpec, load_spec
 from creaturegen.surface.frames import (
@@ -23,7 +24,6 @@ from creaturegen.surface.frames import (
     slot_radial,
     twisted,
 )
-from creaturegen.surface.skeleton import Skeleton, build_skeleton
 
 F64 = npt.NDArray[np.float64]
 CREATURES = [p for p in sorted(EXAMPLES.rglob("*.json")) if "frost" not in p.parts]

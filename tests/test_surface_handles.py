@@ -16,7 +16,8 @@ import numpy as np
 import pytest
 
 from conftest import REPO, rest_surface, run_cli
-from creaturegen.field import layout as col
+from creaturegen.model import layout as col
+from creaturegen.model.skeleton import build_skeleton
 from creaturegen.rig import compile_rig
 from creaturegen.spec import CharacterSpec, load_spec
 from creaturegen.surface.build import SurfaceRejectedError, build_surface
@@ -31,7 +32,6 @@ from creaturegen.surface.handles import (
     uncut,
 )
 from creaturegen.surface.mesh import Mesh
-from creaturegen.surface.skeleton import build_skeleton
 
 FIXTURES = Path(__file__).parent / "fixtures"
 PINCER = FIXTURES / "pincer.json"

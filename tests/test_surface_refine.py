@@ -7,6 +7,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from creaturegen.model.skeleton import build_skeleton
 from creaturegen.rig import compile_rig
 from creaturegen.spec import CharacterSpec, load_spec
 from creaturegen.surface import build
@@ -21,7 +22,6 @@ from creaturegen.surface.build import (
 )
 from creaturegen.surface.grid import BLOCK, Grid
 from creaturegen.surface.sampling import _block_nodes
-from creaturegen.surface.skeleton import build_skeleton
 
 #: Generated seed 4: a handle at its first three distant lattices that no unjoined pair makes certain.
 UNTIL_FINE = Path(__file__).parent / "fixtures" / "genus-until-fine-quadruped.json"
@@ -87,8 +87,8 @@ def test_a_pointed_tip_starts_at_the_first_lattice_cap_and_refines_up_to_the_lim
     import numpy as np
     import pytest
 
-    from creaturegen.field import layout as col
-    from creaturegen.rig.graph import BlendGraph
+    from creaturegen.model import layout as col
+    from creaturegen.model.graph import BlendGraph
     from creaturegen.surface.grid import (
         BLOCK,
         FIRST_CELLS_LIMIT,

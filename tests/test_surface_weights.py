@@ -16,10 +16,10 @@ import numpy as np
 import pytest
 
 from conftest import EXAMPLES, rest_surface
+from creaturegen.model.skeleton import Skeleton, build_skeleton
 from creaturegen.spec import CharacterSpec, load_spec
 from creaturegen.surface.field64 import BodyField
 from creaturegen.surface.mesh import Mesh
-from creaturegen.surface.skeleton import Skeleton, build_skeleton
 from creaturegen.surface.weights import LEAKAGE_MAX, SkinWeights, neighbour_matrix, skin_weights
 
 EXAMPLE_NAMES = ["beetle.json", "reference/quadruped.json", "lizard.json", "moth.json"]

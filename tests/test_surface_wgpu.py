@@ -27,9 +27,9 @@ import numpy.typing as npt
 import pytest
 
 from conftest import EXAMPLES, missing_setup
-from creaturegen.field import layout
+from creaturegen.model import layout
+from creaturegen.model.graph import BlendGraph, Ref
 from creaturegen.rig import CompiledRig, compile_rig
-from creaturegen.rig.graph import BlendGraph, Ref
 from creaturegen.spec import CharacterSpec, load_spec
 from creaturegen.surface.backends import BackendUnavailableError, NumpyBackend, make_backend
 from creaturegen.surface.wgpu_field import WgpuBackend, _device

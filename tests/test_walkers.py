@@ -11,11 +11,11 @@ import jsonschema
 import pytest
 
 from conftest import REPO
+from creaturegen.model.skeleton import build_skeleton
 from creaturegen.motion.rig import WALKERS, build_motion
 from creaturegen.rig import compile_rig
 from creaturegen.spec import CharacterSpec, SpecValidationError, load_spec, validate_bytes
 from creaturegen.spec.character import LEG_COUNTS, WALKER_LEG_COUNTS
-from creaturegen.surface.skeleton import build_skeleton
 
 SPIDER = Path(__file__).parent / "fixtures" / "spider.json"
 

@@ -15,9 +15,9 @@ from dataclasses import dataclass
 import numpy as np
 import numpy.typing as npt
 
-from ..field import layout as col
 from ..field.primitives import primitive_field, slot_uses_round_cone
-from ..rig.graph import BlendGraph, Ref
+from ..model import layout as col
+from ..model.graph import BlendGraph, Ref
 
 FloatArray = npt.NDArray[np.float64]
 

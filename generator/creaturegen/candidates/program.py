@@ -27,8 +27,8 @@ from typing import Literal
 
 import numpy as np
 
-from ..field import layout as col
-from ..rig.graph import BlendGraph, BlendOp, Ref
+from ..model import layout as col
+from ..model.graph import BlendGraph, BlendOp, Ref
 from .bounds import LeafBounds, SubtreeInfo, ref_interval, ref_leaves
 
 CertificateKind = Literal["poly-saturation", "lse-tail", "root-min", "colour-weight"]

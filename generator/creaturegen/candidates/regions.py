@@ -8,7 +8,7 @@ the region and the uncertified omission named.
 
 Selection is greedy: start from the leaf with the smallest lower bound, and while a certificate fails,
 add the omitted leaf with the smallest lower bound among the failing ones. Geometry decides every
-choice; ties break on slot index, which is canonical (rig/graph.py).
+choice; ties break on slot index, which is canonical (model/graph.py).
 """
 
 from __future__ import annotations
@@ -17,9 +17,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..field import layout as col
+from ..model import layout as col
+from ..model.graph import BlendGraph
 from ..rig import CompiledRig
-from ..rig.graph import BlendGraph
 from .bounds import LeafBounds, leaf_bounds, subtree_info
 from .program import CandidateProgram, build_program
 

@@ -17,12 +17,12 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..field import layout as col
 from ..field.sampler import sample_graph
+from ..model import layout as col
+from ..model.graph import BlendGraph
+from ..model.rotations import Pose, posed_slots
 from ..rig import CompiledRig
 from ..rig.colour import linear_to_oklab
-from ..rig.graph import BlendGraph
-from ..surface.deform import Pose, posed_slots
 from .program import CandidateProgram
 
 

@@ -17,7 +17,7 @@ import copy
 import json
 from typing import Any, Final
 
-from .pose import lcg_next
+from ..model.lcg import lcg_next
 
 #: Genes of one identity, in draw order.
 GENES: Final = ("girth", "limbs", "tails")

@@ -15,19 +15,20 @@ import numpy as np
 
 from .. import __version__
 from ..candidates import CandidateSet, TierRejectedError, build_candidates
-from ..field import layout as col
 from ..field.floors import floors_for
 from ..field.primitives import GRADIENT_FLOOR, slot_uses_round_cone
+from ..model import layout as col
+from ..model.genome import genetics_data, slot_lab
+from ..model.lcg import LCG_A, LCG_C
+from ..model.skeleton import Skeleton, build_skeleton
 from ..motion.rig import build_motion
 from ..rig import CompiledRig
 from ..spec import CharacterSpec, slugify
 from ..surface import correct as correction
 from ..surface.build import NO_PROGRAM, SKIN_PROGRAM, SurfaceBuild
 from ..surface.deform import METHODS
-from ..surface.skeleton import Skeleton, build_skeleton
 from .assets import asset_plan
-from .genome import genetics_data, slot_lab
-from .pose import LCG_A, LCG_C, POSE_ROWS
+from .pose import POSE_ROWS
 from .tape import Tape, compile_tape
 
 #: The runtime's debug views (lab `setDebugMode`); "shell" is the diagnostic capsule shell.
@@ -123,7 +124,7 @@ def build_plan(
         "slotNames": list(skeleton.names),
         "roundCone": [int(x) for x in slot_uses_round_cone(rig.slots)],
         "lcg": {"a": LCG_A, "c": LCG_C},
-        # Colour genes mutate these OKLab coordinates of the authored colours (creature/genome.py).
+        # Colour genes mutate these OKLab coordinates of the authored colours (model/genome.py).
         "genetics": genetics_data(spec.genetics),
         "slotLab": slot_lab(rig.slots[:, col.RGB]),
         "motion": motion,

@@ -6,10 +6,10 @@ its per-slot quaternions and translations, ``x' = R(q_s)·x + t_s`` in creature-
 rows (core/pose.js writePoseRows, the same arithmetic in the same order as ``pose_rows``):
 
 - per slot, POSE_ROWS vec4: (a, ra), (b, rb), (k, rgb), quaternion xyzw, (t, roundCone), where rgb is
-  the individual's colour (creature/genome.py genome_colours);
+  the individual's colour (model/genome.py genome_colours);
 - after the slots, two root rows: (x, y, z, alive), (cos yaw, sin yaw, squash, size).
 
-An individual's size s (creature/genome.py) scales its rest geometry before the slot transforms: the rows
+An individual's size s (model/genome.py) scales its rest geometry before the slot transforms: the rows
 hold ``R(q_s)·(s·a) + t_s``, ``s·r`` and ``s·k``; the GPU scales every blend op's k (tsl/field.js) and each
 rest vertex, centre of rotation and trust radius (tsl/body.js) by the root row's size, so the drawn body
 is the certified one scaled by s.
@@ -21,57 +21,27 @@ instance from its seed.
 from __future__ import annotations
 
 import dataclasses
-import math
 from collections.abc import Sequence
 from typing import Final
 
 import numpy as np
 import numpy.typing as npt
 
-from ..field import layout as col
 from ..field.primitives import slot_uses_round_cone
+from ..model import layout as col
+from ..model.graph import BlendGraph
+from ..model.rotations import Pose, quaternion_to_matrix
 from ..motion import quat as vq
 from ..rig import CompiledRig
-from ..rig.graph import BlendGraph
-from ..surface.deform import Pose, quaternion_to_matrix
 
 F64 = npt.NDArray[np.float64]
 
 #: Rows of four floats per slot in a pose page: (a, ra), (b, rb), (k, rgb), quaternion xyzw, (t, roundCone).
 POSE_ROWS: Final = 5
-#: Numerical Recipes LCG, modulo 2³².
-LCG_A: Final = 1664525
-LCG_C: Final = 1013904223
-
-
-def lcg_next(state: int) -> int:
-    return (LCG_A * state + LCG_C) % (1 << 32)
-
-
-def mix_seed(seed: int) -> int:
-    """The first state of an instance's LCG stream: ``seed`` through murmur3's 32-bit finaliser.
-
-    An LCG is affine, so the k-th draws of consecutive seeds would form an arithmetic progression: spawn
-    seeds 0, 1, 2, … would get headings and genes on a regular lattice. The finaliser decorrelates them.
-    """
-    h = seed % (1 << 32)
-    h ^= h >> 16
-    h = (h * 0x85EBCA6B) & 0xFFFFFFFF
-    h ^= h >> 13
-    h = (h * 0xC2B2AE35) & 0xFFFFFFFF
-    h ^= h >> 16
-    return h
-
-
-def instance_yaw(seed: int) -> float:
-    """Yaw in [0, 2π) of an instance spawned from ``seed``: the second draw of its stream (the first is
-    reserved)."""
-    second = lcg_next(lcg_next(mix_seed(seed)))
-    return second / 4294967296.0 * 2.0 * math.pi
 
 
 def as_pose(quats: Sequence[Sequence[float]], trans: Sequence[Sequence[float]]) -> Pose:
-    """Per-slot quaternions (xyzw) and translations as a deform.Pose (what the numpy skinning consumes)."""
+    """Per-slot quaternions (xyzw) and translations as a rotations.Pose (what the numpy skinning consumes)."""
     q = np.asarray(quats, dtype=np.float64)
     wxyz = np.concatenate([q[:, 3:4], q[:, :3]], axis=1)
     return Pose(quaternion_to_matrix(wxyz), np.asarray(trans, dtype=np.float64))
@@ -100,7 +70,7 @@ def pose_rows(
     size: float = 1.0,
 ) -> npt.NDArray[np.float32]:
     """(S, POSE_ROWS, 4) float32 rows of one instance's pose page entry, as the JS core writes them;
-    ``colours`` is the individual's per-slot linear rgb (creature/genome.py), else the authored one;
+    ``colours`` is the individual's per-slot linear rgb (model/genome.py), else the authored one;
     ``size`` its size factor (Motion.size)."""
     slots = sized_slots(rig.slots, size)
     t = np.asarray(trans, dtype=np.float64)

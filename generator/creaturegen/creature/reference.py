@@ -14,21 +14,22 @@ from typing import Any
 import numpy as np
 import numpy.typing as npt
 
-from ..field import layout as col
 from ..field.floors import floors_for
 from ..field.sampler import FieldSample, sample_graph
+from ..model import layout as col
+from ..model.genome import draw_genome, genetics_data, genome_colours, slot_lab
+from ..model.graph import Ref
+from ..model.rotations import Pose, posed_slots
+from ..model.skeleton import build_skeleton
 from ..motion.providers import AnalyticWater
 from ..motion.rig import build_motion
 from ..motion.simulate import Motion
 from ..rig import CompiledRig, compile_rig
-from ..rig.graph import Ref
 from ..spec import CharacterSpec, validate_bytes
 from ..surface.asset import SurfaceAsset, read_glb
 from ..surface.build import SKIN_PROGRAM
-from ..surface.deform import Pose, posed_slots, skin_cor, skin_dq, skin_lbs
-from ..surface.skeleton import build_skeleton
+from ..surface.deform import skin_cor, skin_dq, skin_lbs
 from .assets import SPEC_PATH, surface_path
-from .genome import draw_genome, genetics_data, genome_colours, slot_lab
 from .pose import sized_graph, sized_slots
 
 F64 = npt.NDArray[np.float64]

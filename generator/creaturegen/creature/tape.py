@@ -22,7 +22,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import Final
 
-from ..rig.graph import BlendGraph, Ref
+from ..model.graph import BlendGraph, Ref
 
 LEAF: Final = 0
 POLY: Final = 1

@@ -8,13 +8,13 @@ min. The gradient is carried unnormalised, exactly as the GPU code does.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Protocol
 
 import numpy as np
 import numpy.typing as npt
 
-from ..rig import CompiledRig
-from ..rig.graph import BlendGraph, Ref
-from . import layout as col
+from ..model import layout as col
+from ..model.graph import BlendGraph, Ref
 from .blend import hard_min, lse_smin, lse_smin_distance, poly_smin, poly_smin_distance
 from .colour import proximity_colour
 from .floors import floors_for
@@ -123,6 +123,18 @@ def sample_graph(
     return FieldSample(distance, gradient, color)
 
 
-def sample(rig: CompiledRig, points: npt.ArrayLike, dtype: type[np.floating] = np.float64) -> FieldSample:
+class CompiledBody(Protocol):
+    """What the sampler reads of a compiled rig (rig.CompiledRig has it), so the field sits below the
+    compiler: the blend program, the slot table and the body scale its floors follow."""
+
+    @property
+    def graph(self) -> BlendGraph: ...
+    @property
+    def slots(self) -> npt.NDArray[np.float64]: ...
+    @property
+    def body_scale(self) -> float: ...
+
+
+def sample(rig: CompiledBody, points: npt.ArrayLike, dtype: type[np.floating] = np.float64) -> FieldSample:
     """Evaluate the rest-pose field at points of shape (P, 3)."""
     return sample_graph(rig.graph, rig.slots, points, floors_for(rig.body_scale).k_floor, dtype)

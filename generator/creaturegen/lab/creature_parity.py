@@ -43,9 +43,9 @@ from playwright.sync_api import Page
 from scipy import ndimage
 
 from ..creature import reference as cref
-from ..creature.genome import slot_lab
 from ..creature.pose import POSE_ROWS, as_pose, pose_rows, root_rows
-from ..field import layout as col
+from ..model import layout as col
+from ..model.genome import slot_lab
 from ..motion.simulate import Motion
 from ..surface.build import SKIN_PROGRAM
 from .browser import LabPage, launch_lab_page

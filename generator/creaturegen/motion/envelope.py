@@ -47,15 +47,15 @@ from typing import Any, Final
 import numpy as np
 import numpy.typing as npt
 
+from ..cachedir import default_cache_root
 from ..codedigest import stage_digest
-from ..creature.genome import MAX_GAIT_GENES, Genome, express
-from ..creature.pose import instance_yaw
-from ..field import layout as col
+from ..model import layout as col
+from ..model.genome import MAX_GAIT_GENES, Genome, express
+from ..model.lcg import instance_yaw
+from ..model.rotations import Pose, quaternion_multiply, quaternion_to_matrix
+from ..model.skeleton import Skeleton, build_skeleton, joint_frame
 from ..rig import CompiledRig
 from ..spec import CharacterSpec
-from ..surface.asset import default_cache_root
-from ..surface.deform import Pose, joint_frame, quaternion_multiply, quaternion_to_matrix
-from ..surface.skeleton import Skeleton, build_skeleton
 from .derived import MotionRangeError, derive
 from .providers import AnalyticWater, FlatGround, Gravity, Support, builtin_supports
 from .rig import WALKERS, build_motion

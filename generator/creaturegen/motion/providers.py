@@ -13,8 +13,8 @@ import math
 from dataclasses import dataclass, field
 from typing import Final, Protocol
 
+from ..model.trig import pcos, psin
 from .quat import Vec
-from .trig import pcos, psin
 
 STANDARD_GRAVITY: Final = 9.80665
 #: Water channels the swimmer reads; without any of them the tier is refused. The shared sample also names

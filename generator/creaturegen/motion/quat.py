@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import math
 
-from .trig import pcos, psin
+from ..model.trig import pcos, psin
 
 Vec = list[float]
 Quat = list[float]

@@ -11,10 +11,10 @@ from __future__ import annotations
 import math
 from typing import Any, Final
 
-from ..field import layout as col
+from ..model import layout as col
+from ..model.skeleton import Skeleton
 from ..rig import CompiledRig
 from ..spec import CharacterSpec, character
-from ..surface.skeleton import Skeleton
 from . import quat as vq
 
 #: Walkers, hoppers and swimmers circle at this many body lengths (flyers use their spec radius).
@@ -63,14 +63,14 @@ ROPE_BEND_LIMIT_DEG: Final = 60.0
 #: The walking locomotion types (spec/character.py, where validation reads them too).
 WALKERS: Final = character.WALKERS
 #: locomotion type -> its gait genes, each the motion-data fields one gene scales together
-#: (creature/genome.py express_gait): pace scales speed with step or hop length, so timing in ticks holds.
+#: (model/genome.py express_gait): pace scales speed with step or hop length, so timing in ticks holds.
 GAIT_GENES: Final[dict[str, tuple[tuple[str, ...], ...]]] = {
     **dict.fromkeys(WALKERS, (("speed", "stepLength"), ("stepHeight",))),
     "hopper": (("speed", "hopLength"), ("hopHeight",)),
     "flyer": (("speed",), ("pathRadius",), ("altitude",)),
     "swimmer": (("speed",), ("undulation",)),
 }
-#: The motion-data fields that are lengths, which an individual's size s scales (creature/genome.py
+#: The motion-data fields that are lengths, which an individual's size s scales (model/genome.py
 #: express_size), and those that are speeds, which it scales by √s: Froude similarity (v²/gL held), so with
 #: gravity unscaled every time derived from lengths, speeds and gravity (stance, swing, air, hop cycle, flap
 #: and undulation periods) scales by √s alike and the gait keeps its proportions. The hopper's stated crouch

@@ -20,8 +20,9 @@ import struct
 from dataclasses import dataclass, field
 from typing import Any
 
-from ..creature.genome import Genome, draw_genome, express, individual_size
-from ..creature.pose import instance_yaw
+from ..model.genome import Genome, draw_genome, express, individual_size
+from ..model.lcg import instance_yaw
+from ..model.trig import pcos, psin
 from . import quat as vq
 from .derived import Derived, derive
 from .ik import solve_leg
@@ -37,7 +38,6 @@ from .providers import (
 )
 from .quat import Vec
 from .rig import WALKERS
-from .trig import pcos, psin
 
 Z_AXIS = [0.0, 0.0, 1.0]
 Y_AXIS = [0.0, 1.0, 0.0]

@@ -1,7 +1,7 @@
 """Rig compile: a validated CharacterSpec becomes a slot table and a blend program.
 
-The slot table is one float64 row per slot, ``a.xyz, ra, b.xyz, rb, k, r, g, b`` (field/layout.py), in
-canonical order (rig/graph.py). Problems the gate cannot see because they only appear once geometry is
+The slot table is one float64 row per slot, ``a.xyz, ra, b.xyz, rb, k, r, g, b`` (model/layout.py), in
+canonical order (model/graph.py). Problems the gate cannot see because they only appear once geometry is
 laid out and scaled (nested cone ends, a blend width that overflows or swallows the body) raise
 RigCompileError naming the part or node.
 """
@@ -13,11 +13,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..field import layout as col
+from ..model import layout as col
+from ..model.graph import BlendGraph, Combine, Expr, Key, PartLeaf, flatten, subtree_key
 from ..spec import CharacterSpec, SpecError
 from ..spec.character import Part
 from .colour import DEFAULT_COLOR, hex_to_linear
-from .graph import BlendGraph, Combine, Expr, Key, PartLeaf, flatten, subtree_key
 from .layout import origins, part_slots
 
 #: Default leaf blend width as a fraction of the part radius (seed: k = 0.6·r, capped by kCap).

@@ -5,9 +5,9 @@ from __future__ import annotations
 from dataclasses import asdict
 from typing import Any
 
-from ..field import layout as col
 from ..field.floors import floors_for
 from ..field.primitives import slot_uses_round_cone
+from ..model import layout as col
 from .compile import CompiledRig
 from .signatures import compiler_description, signatures
 

@@ -17,9 +17,9 @@ from dataclasses import asdict, dataclass
 import numpy as np
 
 from .. import __version__
-from ..field import layout as col
 from ..field.floors import floors_for
 from ..field.primitives import TAPER_EXACT_THRESHOLD
+from ..model import layout as col
 from .compile import DEFAULT_K_FACTOR, CompiledRig
 from .layout import LEG_DROP_MAX, LEG_DROP_MIN
 

@@ -64,6 +64,7 @@ import numpy as np
 import numpy.typing as npt
 
 from .. import __version__
+from ..cachedir import default_cache_root
 
 GLB_MAGIC: Final = 0x46546C67  # "glTF"
 GLB_VERSION: Final = 2
@@ -504,12 +505,6 @@ _HEX = re.compile(r"[0-9a-f]{16,}")
 _TIER = re.compile(r"[A-Za-z0-9][A-Za-z0-9_.-]{0,63}")
 CACHE_KEY: Final = "cacheKey"
 PREFIX: Final = 16
-
-
-def default_cache_root() -> Path:
-    """``$CREATUREGEN_CACHE`` when set, else ``~/.cache/creaturegen/surface``."""
-    configured = os.environ.get("CREATUREGEN_CACHE")
-    return Path(configured) if configured else Path.home() / ".cache" / "creaturegen" / "surface"
 
 
 def _check_hex(value: str, what: str) -> str:

@@ -14,7 +14,7 @@ import numpy as np
 import numpy.typing as npt
 
 from ..field.sampler import sample_distance
-from ..rig.graph import BlendGraph
+from ..model.graph import BlendGraph
 
 Points = npt.NDArray[np.float32]  # (N, 3)
 Distances = npt.NDArray[np.float32]  # (N,)

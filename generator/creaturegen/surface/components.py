@@ -20,8 +20,8 @@ from dataclasses import dataclass
 import numpy as np
 import numpy.typing as npt
 
-from ..field import layout as col
-from ..rig.graph import BlendGraph, Ref
+from ..model import layout as col
+from ..model.graph import BlendGraph, Ref
 from .handles import Contact
 from .mesh import Mesh
 from .topology import components

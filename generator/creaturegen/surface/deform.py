@@ -35,14 +35,21 @@ from typing import Final, Literal
 import numpy as np
 import numpy.typing as npt
 
-from ..field import layout as col
-from ..rig.graph import BlendGraph
+from ..model import layout as col
+from ..model.graph import BlendGraph
+from ..model.rotations import (
+    Pose,
+    matrix_to_quaternion,
+    posed_slots,
+    quaternion_multiply,
+    quaternion_to_matrix,
+)
+from ..model.skeleton import Skeleton, pose_joint, subtree
 from . import topology
 from .correct import correct
 from .field64 import BodyField
 from .gates import SurfaceGate
 from .mesh import Mesh, angles_deg, unit_rows
-from .skeleton import Skeleton
 
 F64 = npt.NDArray[np.float64]
 I64 = npt.NDArray[np.int64]
@@ -155,212 +162,6 @@ class DeformationError(Exception):
 
 
 # ---------------------------------------------------------------------------------------------- poses
-
-
-@dataclass(frozen=True)
-class Pose:
-    """Per-slot rigid transforms rest → posed: ``x' = rotations[s] @ x + translations[s]``."""
-
-    rotations: F64  # (S, 3, 3)
-    translations: F64  # (S, 3)
-
-    @classmethod
-    def identity(cls, slot_count: int) -> Pose:
-        return cls(np.tile(np.eye(3), (slot_count, 1, 1)), np.zeros((slot_count, 3)))
-
-    @classmethod
-    def rigid(cls, slot_count: int, rotation: npt.ArrayLike, translation: npt.ArrayLike) -> Pose:
-        """Every slot under one transform: the whole body moved, which every method must reproduce."""
-        r = np.asarray(rotation, dtype=np.float64).reshape(3, 3)
-        t = np.asarray(translation, dtype=np.float64).reshape(3)
-        return cls(np.tile(r, (slot_count, 1, 1)), np.tile(t, (slot_count, 1)))
-
-    @property
-    def slot_count(self) -> int:
-        return int(self.rotations.shape[0])
-
-
-def rotation_matrix(axis: npt.ArrayLike, angle: float) -> F64:
-    """Rodrigues; the axis need not be unit."""
-    u = np.asarray(axis, dtype=np.float64).reshape(3)
-    u = u / np.linalg.norm(u)
-    k = np.array([[0.0, -u[2], u[1]], [u[2], 0.0, -u[0]], [-u[1], u[0], 0.0]])
-    result: F64 = np.eye(3) + math.sin(angle) * k + (1.0 - math.cos(angle)) * (k @ k)
-    return result
-
-
-def subtree(skeleton: Skeleton, slot: int) -> Bools:
-    """(S,) the slot and every slot hanging below it: what moves when its joint turns."""
-    parent = np.asarray(skeleton.parent)
-    inside = np.zeros(parent.size, dtype=bool)
-    inside[slot] = True
-    while True:
-        grown: Bools = inside | ((parent >= 0) & inside[np.maximum(parent, 0)])
-        if (grown == inside).all():
-            return grown
-        inside = grown
-
-
-def joint_frame(skeleton: Skeleton, rest_slots: F64, child: int) -> tuple[F64, F64, F64]:
-    """The child's rest tangent and two bend axes perpendicular to it.
-
-    A sphere child has no axis of its own, so its tangent runs from the pivot to its centre. The first
-    bend axis is perpendicular to both the child's and the parent's tangent (the hinge that folds the
-    child towards its parent); a straight chain falls back to the world axis least aligned with it, so
-    the frame is deterministic.
-    """
-    a, b = rest_slots[child, col.A], rest_slots[child, col.B]
-    scale = max(float(rest_slots[child, col.RA]), 1e-300)
-    tangent = b - a
-    if np.linalg.norm(tangent) <= 1e-9 * scale:
-        tangent = a - skeleton.pivot[child]
-    parent = skeleton.parent[child]
-    parent_tangent = (
-        rest_slots[parent, col.B] - rest_slots[parent, col.A]
-        if parent >= 0
-        else np.zeros(3, dtype=np.float64)
-    )
-    if np.linalg.norm(tangent) <= 1e-9 * scale:
-        tangent = parent_tangent if np.linalg.norm(parent_tangent) > 0 else np.array([0.0, 1.0, 0.0])
-    tangent = tangent / np.linalg.norm(tangent)
-    e1 = np.cross(tangent, parent_tangent)
-    if np.linalg.norm(e1) <= 1e-6 * max(float(np.linalg.norm(parent_tangent)), 1e-300):
-        e1 = np.cross(tangent, np.eye(3)[int(np.argmin(np.abs(tangent)))])
-    e1 = e1 / np.linalg.norm(e1)
-    e2 = np.cross(tangent, e1)
-    return tangent, e1, e2
-
-
-def pose_joint(
-    skeleton: Skeleton,
-    rest_slots: F64,
-    joint_child: int,
-    bend_axis: int | npt.ArrayLike,
-    bend_angle: float,
-    twist_angle: float,
-) -> Pose:
-    """Turn ``joint_child`` and everything below it about its pivot; every other slot stays at rest.
-
-    ``bend_axis`` is 0 or 1 (the axes of :func:`joint_frame`) or a vector, projected perpendicular to
-    the child's tangent. The twist (about the rest tangent) is applied first, then the bend, so a twist
-    spins the limb about its own axis whatever the bend. Angles in radians.
-    """
-    tangent, e1, e2 = joint_frame(skeleton, rest_slots, joint_child)
-    if isinstance(bend_axis, int | np.integer):
-        axis = (e1, e2)[int(bend_axis)]
-    else:
-        axis = np.asarray(bend_axis, dtype=np.float64).reshape(3)
-        axis = axis - (axis @ tangent) * tangent
-        if np.linalg.norm(axis) <= 1e-12 * max(float(np.linalg.norm(bend_axis)), 1e-300):
-            if bend_angle != 0.0:
-                raise ValueError("bend_axis is parallel to the child's tangent: that is a twist")
-            axis = e1
-    q = rotation_matrix(axis, bend_angle) @ rotation_matrix(tangent, twist_angle)
-    pivot = skeleton.pivot[joint_child]
-    pose = Pose.identity(len(skeleton.parent))
-    moved = subtree(skeleton, joint_child)
-    pose.rotations[moved] = q
-    pose.translations[moved] = pivot - q @ pivot
-    return pose
-
-
-def posed_slots(rest_slots: F64, pose: Pose) -> F64:
-    """The slot table with both ends moved by their slot's transform; radii, k and colour stay."""
-    out = rest_slots.copy()
-    for ends in (col.A, col.B):
-        out[:, ends] = np.einsum("sij,sj->si", pose.rotations, rest_slots[:, ends]) + pose.translations
-    return out
-
-
-# ----------------------------------------------------------------------------------------- quaternions
-
-
-def matrix_to_quaternion(rotations: F64) -> F64:
-    """(..., 3, 3) → (..., 4) unit quaternions with w ≥ 0 (Shepperd: divide by the largest component)."""
-    m = np.asarray(rotations, dtype=np.float64).reshape(-1, 3, 3)
-    m00, m11, m22 = m[:, 0, 0], m[:, 1, 1], m[:, 2, 2]
-    trace = m00 + m11 + m22
-    case = np.argmax(np.stack([trace, m00, m11, m22], axis=1), axis=1)
-    with np.errstate(invalid="ignore", divide="ignore"):
-        s0 = np.sqrt(np.maximum(1.0 + trace, 0.0)) * 2.0
-        s1 = np.sqrt(np.maximum(1.0 + m00 - m11 - m22, 0.0)) * 2.0
-        s2 = np.sqrt(np.maximum(1.0 - m00 + m11 - m22, 0.0)) * 2.0
-        s3 = np.sqrt(np.maximum(1.0 - m00 - m11 + m22, 0.0)) * 2.0
-        candidates = np.stack(
-            [
-                np.stack(
-                    [
-                        0.25 * s0,
-                        (m[:, 2, 1] - m[:, 1, 2]) / s0,
-                        (m[:, 0, 2] - m[:, 2, 0]) / s0,
-                        (m[:, 1, 0] - m[:, 0, 1]) / s0,
-                    ],
-                    axis=1,
-                ),
-                np.stack(
-                    [
-                        (m[:, 2, 1] - m[:, 1, 2]) / s1,
-                        0.25 * s1,
-                        (m[:, 0, 1] + m[:, 1, 0]) / s1,
-                        (m[:, 0, 2] + m[:, 2, 0]) / s1,
-                    ],
-                    axis=1,
-                ),
-                np.stack(
-                    [
-                        (m[:, 0, 2] - m[:, 2, 0]) / s2,
-                        (m[:, 0, 1] + m[:, 1, 0]) / s2,
-                        0.25 * s2,
-                        (m[:, 1, 2] + m[:, 2, 1]) / s2,
-                    ],
-                    axis=1,
-                ),
-                np.stack(
-                    [
-                        (m[:, 1, 0] - m[:, 0, 1]) / s3,
-                        (m[:, 0, 2] + m[:, 2, 0]) / s3,
-                        (m[:, 1, 2] + m[:, 2, 1]) / s3,
-                        0.25 * s3,
-                    ],
-                    axis=1,
-                ),
-            ],
-            axis=1,
-        )
-    q = candidates[np.arange(m.shape[0]), case]
-    q = q / np.linalg.norm(q, axis=1, keepdims=True)
-    q = np.where(q[:, :1] < 0, -q, q)
-    result: F64 = q.reshape(*np.shape(rotations)[:-2], 4)
-    return result
-
-
-def quaternion_to_matrix(q: F64) -> F64:
-    """(..., 4) unit quaternions → (..., 3, 3); (1, 0, 0, 0) maps to the identity exactly."""
-    w, x, y, z = q[..., 0], q[..., 1], q[..., 2], q[..., 3]
-    result: F64 = np.stack(
-        [
-            np.stack([1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)], axis=-1),
-            np.stack([2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)], axis=-1),
-            np.stack([2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)], axis=-1),
-        ],
-        axis=-2,
-    )
-    return result
-
-
-def quaternion_multiply(a: F64, b: F64) -> F64:
-    aw, ax, ay, az = a[..., 0], a[..., 1], a[..., 2], a[..., 3]
-    bw, bx, by, bz = b[..., 0], b[..., 1], b[..., 2], b[..., 3]
-    result: F64 = np.stack(
-        [
-            aw * bw - ax * bx - ay * by - az * bz,
-            aw * bx + ax * bw + ay * bz - az * by,
-            aw * by - ax * bz + ay * bw + az * bx,
-            aw * bz + ax * by - ay * bx + az * bw,
-        ],
-        axis=-1,
-    )
-    return result
 
 
 def _dual_quaternions(pose: Pose) -> tuple[F64, F64]:

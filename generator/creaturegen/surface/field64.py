@@ -14,7 +14,7 @@ import numpy.typing as npt
 
 from ..field.primitives import primitive_distance, primitive_field
 from ..field.sampler import evaluate_distance, evaluate_graph, evaluate_op_distances
-from ..rig.graph import BlendGraph
+from ..model.graph import BlendGraph
 
 F64 = npt.NDArray[np.float64]
 #: Points per evaluation pass: the (slots × points) temporaries of a pass stay cache-sized (results are

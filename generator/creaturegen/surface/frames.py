@@ -36,10 +36,10 @@ from __future__ import annotations
 import numpy as np
 import numpy.typing as npt
 
-from ..field import layout as col
+from ..model import layout as col
+from ..model.skeleton import Skeleton
 from ..rig import CompiledRig
 from .mesh import unit_rows
-from .skeleton import Skeleton
 
 F64 = npt.NDArray[np.float64]
 

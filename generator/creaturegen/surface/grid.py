@@ -20,9 +20,9 @@ from dataclasses import dataclass
 import numpy as np
 import numpy.typing as npt
 
-from ..field import layout as col
 from ..field.primitives import TAPER_EXACT_THRESHOLD
-from ..rig.graph import BlendGraph
+from ..model import layout as col
+from ..model.graph import BlendGraph
 
 #: Surface-error target per tier, as a fraction of the smallest primitive radius (sagitta bound). The
 #: lower tiers' are the hero's times 2 and 4, so their lattices are the hero's one and two √2 steps

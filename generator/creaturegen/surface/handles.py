@@ -26,10 +26,10 @@ import numpy.typing as npt
 from scipy.sparse import coo_matrix
 from scipy.sparse.csgraph import connected_components
 
-from ..field import layout as col
+from ..model import layout as col
+from ..model.skeleton import Skeleton
 from .grid import LIPSCHITZ_BOUND
 from .mesh import Mesh
-from .skeleton import Skeleton
 from .topology import EdgeTable, components, corner_fans, edge_table
 
 F64 = npt.NDArray[np.float64]

@@ -44,6 +44,8 @@ import numpy as np
 import numpy.typing as npt
 
 from ..field.primitives import primitive_distance
+from ..model import rotations
+from ..model.skeleton import Skeleton
 from ..rig import CompiledRig
 from . import deform
 from .correct import correct
@@ -60,7 +62,6 @@ from .intersect import (
     triangle_pairs,
 )
 from .mesh import Mesh, angles_deg, unit_rows
-from .skeleton import Skeleton
 
 F64 = npt.NDArray[np.float64]
 I64 = npt.NDArray[np.int64]
@@ -120,7 +121,7 @@ class PosedQuality:
 
 
 #: Positions and normals (V, 3) of every vertex skinned to a pose, each by its joint's method.
-Skinner = Callable[[deform.Pose], tuple[F64, F64]]
+Skinner = Callable[[rotations.Pose], tuple[F64, F64]]
 
 
 def choice_skinner(
@@ -132,7 +133,7 @@ def choice_skinner(
 ) -> Skinner:
     """The build's skin: :func:`deform.skin` with the chosen methods."""
 
-    def skin(pose: deform.Pose) -> tuple[F64, F64]:
+    def skin(pose: rotations.Pose) -> tuple[F64, F64]:
         s = deform.skin(
             mesh.vertices, normals, weights[0], weights[1], pose, choice.methods, skeleton, choice.centers
         )
@@ -142,12 +143,12 @@ def choice_skinner(
 
 
 def shipped_pose(
-    rig: CompiledRig, mesh: Mesh, skin: Skinner, radius: F64, pose: deform.Pose
+    rig: CompiledRig, mesh: Mesh, skin: Skinner, radius: F64, pose: rotations.Pose
 ) -> tuple[F64, BodyField]:
     """The vertices as the runtime draws them at ``pose`` (skin, then the correction where ``radius`` >
     0), and the posed field they are measured against."""
     positions, skinned_normals = skin(pose)
-    field = BodyField(rig.graph, deform.posed_slots(rig.slots, pose))
+    field = BodyField(rig.graph, rotations.posed_slots(rig.slots, pose))
     region = radius > 0
     if region.any():
         positions, _ = correct(field, mesh, positions, skinned_normals, region, radius)
@@ -233,7 +234,7 @@ def seen(posed: Mesh, faces: I64, outward: F64) -> Bools:
 
 
 def _rigid_groups(
-    weights: tuple[npt.NDArray[np.int32], F64], faces: npt.NDArray[np.integer], pose: deform.Pose
+    weights: tuple[npt.NDArray[np.int32], F64], faces: npt.NDArray[np.integer], pose: rotations.Pose
 ) -> I64:
     """(F,) a face's rigid group at ``pose``: the class of slots sharing one transform that binds every
     corner wholly, or −1 where a corner blends transforms (a seam)."""
@@ -294,7 +295,7 @@ def pose_quality(
     weights: tuple[npt.NDArray[np.int32], F64],
     skin: Skinner,
     radius: F64,
-    pose: deform.Pose,
+    pose: rotations.Pose,
     label: str,
     edges: I64,
     rest_turn: F64,
@@ -349,7 +350,7 @@ def posed_quality(
     weights: tuple[npt.NDArray[np.int32], F64],
     skin: Skinner,
     radius: F64,
-    poses: Sequence[deform.Pose],
+    poses: Sequence[rotations.Pose],
     labels: Sequence[str],
 ) -> PosedQuality:
     """Every envelope pose measured (see the module docstring); ``radius`` is the runtime's correction

@@ -19,7 +19,7 @@ import numpy as np
 import numpy.typing as npt
 
 from ..field.sampler import sample_distance
-from ..rig.graph import BlendGraph
+from ..model.graph import BlendGraph
 from .backends import FieldBackend
 from .grid import BLOCK, LIPSCHITZ_BOUND, Grid
 

@@ -87,11 +87,11 @@ import scipy.sparse as sp
 from scipy.sparse.csgraph import connected_components
 from scipy.sparse.linalg import splu
 
-from ..field import layout as col
+from ..model import layout as col
+from ..model.skeleton import Skeleton
 from .field64 import BodyField
 from .gates import SurfaceGate
 from .mesh import Mesh
-from .skeleton import Skeleton
 
 F64 = npt.NDArray[np.float64]
 I32 = npt.NDArray[np.int32]

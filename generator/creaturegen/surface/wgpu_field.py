@@ -38,9 +38,9 @@ from typing import Any
 import numpy as np
 import numpy.typing as npt
 
-from ..field import layout
 from ..field.primitives import GRADIENT_FLOOR, slot_uses_round_cone
-from ..rig.graph import BlendGraph, Ref
+from ..model import layout
+from ..model.graph import BlendGraph, Ref
 from .backends import BackendUnavailableError, Distances, Points
 
 #: Invocations per workgroup; the dispatch covers ``ceil(n / 64)`` workgroups and the kernel guards

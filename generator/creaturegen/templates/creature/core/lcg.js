@@ -1,5 +1,5 @@
 // The seeded LCG (Numerical Recipes, modulo 2^32): the only source of variation in this package.
-// Integer arithmetic, so Python's reference (creature/pose.py) reproduces every draw exactly.
+// Integer arithmetic, so Python's reference (model/lcg.py) reproduces every draw exactly.
 
 /** Next state of the LCG; `state` is an unsigned 32-bit integer. */
 export function lcgNext(state, a, c) {

@@ -2845,7 +2845,7 @@ export const CREATURE = Object.freeze({
     0
   ],
   "signatures": {
-    "compilerSignature": "5ff7816a299d42380a3fcb3fa32a7f10b56d60e68673e5d0175316f363b3e8ec",
+    "compilerSignature": "36a33be9549746c9ff5c9d8054e10cafeef94b11bc6aece89e32a50e6f76372a",
     "geometryDigest": "400b0d18a2a9f6bbbfe5b441f89767f552a4f3b4c45a368d1129d632e1d2f4f1",
     "topologySignature": "330d551e8c006f84b01459c84db69ca8c43aec5bc9d9083d3e85c291be5a68bf"
   },

@@ -1,4 +1,4 @@
-// Portable sine and cosine: the same fdlibm kernels as creaturegen's Python reference (motion/trig.py).
+// Portable sine and cosine: the same fdlibm kernels as creaturegen's Python reference (model/trig.py).
 // V8's Math.sin and the C library's sin may differ in the last bit, and a driven verlet rope amplifies
 // that a thousandfold within a few hundred ticks. Built from +, −, ×, ÷ and floor only (each correctly
 // rounded, no fused multiply-add in either language), these are bit-identical in Python and JS.
@@ -13,7 +13,7 @@ const C1 = 4.16666666666666019037e-02, C2 = -1.38888888888741095749e-03, C3 = 2.
 const C4 = -2.75573143513906633035e-07, C5 = 2.08757232129817482790e-09, C6 = -1.13596475577881948265e-11;
 
 /**
- * sin and cos of a[ao] into out[o], out[o + 1]: the reference's psin and pcos (motion/trig.py), which share
+ * sin and cos of a[ao] into out[o], out[o + 1]: the reference's psin and pcos (model/trig.py), which share
  * the range reduction and the ksin/kcos kernels, term by term. Angle and results travel through arrays, so
  * no double crosses a call and nothing is boxed (quat.js).
  */

@@ -13,15 +13,30 @@ from __future__ import annotations
 
 import itertools
 from dataclasses import dataclass
+from typing import Protocol
 
 import numpy as np
 import numpy.typing as npt
 
-from ..field import layout as col
-from ..rig import CompiledRig
 from ..spec import CharacterSpec
+from . import layout as col
+from .rotations import Pose, rotation_matrix
 
 F64 = npt.NDArray[np.float64]
+
+
+class SlotTable(Protocol):
+    """What the skeleton reads of a compiled rig (rig.CompiledRig has it): the rest slot table and, per
+    slot, its part and its primitive class."""
+
+    @property
+    def slots(self) -> F64: ...
+    @property
+    def slot_parts(self) -> tuple[str, ...]: ...
+    @property
+    def slot_classes(self) -> tuple[str, ...]: ...
+    @property
+    def slot_count(self) -> int: ...
 
 
 @dataclass(frozen=True)
@@ -69,7 +84,7 @@ def closest_on_segment(a: F64, b: F64, p: F64) -> F64:
     return result
 
 
-def build_skeleton(spec: CharacterSpec, rig: CompiledRig) -> Skeleton:
+def build_skeleton(spec: CharacterSpec, rig: SlotTable) -> Skeleton:
     """Slot parents and pivots from the spec's part parents and the compiled rest slots."""
     slots = rig.slots
     by_part: dict[str, list[int]] = {}
@@ -105,3 +120,81 @@ def build_skeleton(spec: CharacterSpec, rig: CompiledRig) -> Skeleton:
             ordered_names[index] = names[cursor]
             cursor += 1
     return Skeleton(tuple(parent), pivot, tuple(ordered_names))
+
+
+Bools = npt.NDArray[np.bool_]
+
+
+def subtree(skeleton: Skeleton, slot: int) -> Bools:
+    """(S,) the slot and every slot hanging below it: what moves when its joint turns."""
+    parent = np.asarray(skeleton.parent)
+    inside = np.zeros(parent.size, dtype=bool)
+    inside[slot] = True
+    while True:
+        grown: Bools = inside | ((parent >= 0) & inside[np.maximum(parent, 0)])
+        if (grown == inside).all():
+            return grown
+        inside = grown
+
+
+def joint_frame(skeleton: Skeleton, rest_slots: F64, child: int) -> tuple[F64, F64, F64]:
+    """The child's rest tangent and two bend axes perpendicular to it.
+
+    A sphere child has no axis of its own, so its tangent runs from the pivot to its centre. The first
+    bend axis is perpendicular to both the child's and the parent's tangent (the hinge that folds the
+    child towards its parent); a straight chain falls back to the world axis least aligned with it, so
+    the frame is deterministic.
+    """
+    a, b = rest_slots[child, col.A], rest_slots[child, col.B]
+    scale = max(float(rest_slots[child, col.RA]), 1e-300)
+    tangent = b - a
+    if np.linalg.norm(tangent) <= 1e-9 * scale:
+        tangent = a - skeleton.pivot[child]
+    parent = skeleton.parent[child]
+    parent_tangent = (
+        rest_slots[parent, col.B] - rest_slots[parent, col.A]
+        if parent >= 0
+        else np.zeros(3, dtype=np.float64)
+    )
+    if np.linalg.norm(tangent) <= 1e-9 * scale:
+        tangent = parent_tangent if np.linalg.norm(parent_tangent) > 0 else np.array([0.0, 1.0, 0.0])
+    tangent = tangent / np.linalg.norm(tangent)
+    e1 = np.cross(tangent, parent_tangent)
+    if np.linalg.norm(e1) <= 1e-6 * max(float(np.linalg.norm(parent_tangent)), 1e-300):
+        e1 = np.cross(tangent, np.eye(3)[int(np.argmin(np.abs(tangent)))])
+    e1 = e1 / np.linalg.norm(e1)
+    e2 = np.cross(tangent, e1)
+    return tangent, e1, e2
+
+
+def pose_joint(
+    skeleton: Skeleton,
+    rest_slots: F64,
+    joint_child: int,
+    bend_axis: int | npt.ArrayLike,
+    bend_angle: float,
+    twist_angle: float,
+) -> Pose:
+    """Turn ``joint_child`` and everything below it about its pivot; every other slot stays at rest.
+
+    ``bend_axis`` is 0 or 1 (the axes of :func:`joint_frame`) or a vector, projected perpendicular to
+    the child's tangent. The twist (about the rest tangent) is applied first, then the bend, so a twist
+    spins the limb about its own axis whatever the bend. Angles in radians.
+    """
+    tangent, e1, e2 = joint_frame(skeleton, rest_slots, joint_child)
+    if isinstance(bend_axis, int | np.integer):
+        axis = (e1, e2)[int(bend_axis)]
+    else:
+        axis = np.asarray(bend_axis, dtype=np.float64).reshape(3)
+        axis = axis - (axis @ tangent) * tangent
+        if np.linalg.norm(axis) <= 1e-12 * max(float(np.linalg.norm(bend_axis)), 1e-300):
+            if bend_angle != 0.0:
+                raise ValueError("bend_axis is parallel to the child's tangent: that is a twist")
+            axis = e1
+    q = rotation_matrix(axis, bend_angle) @ rotation_matrix(tangent, twist_angle)
+    pivot = skeleton.pivot[joint_child]
+    pose = Pose.identity(len(skeleton.parent))
+    moved = subtree(skeleton, joint_child)
+    pose.rotations[moved] = q
+    pose.translations[moved] = pivot - q @ pivot
+    return pose

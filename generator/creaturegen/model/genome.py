@@ -1,7 +1,7 @@
 """Genomes: what makes one spawned individual differ from another, drawn from its seed by the LCG.
 
 A genome is a handful of signed genes in [-1, 1), each the draw at a fixed index of the LCG stream that
-starts at ``mix_seed(seed)`` (draw 1 is reserved, draw 2 is the heading, see pose.instance_yaw):
+starts at ``mix_seed(seed)`` (draw 1 is reserved, draw 2 is the heading, see lcg.instance_yaw):
 
 - draws 3, 4, 5: hue, chroma, lightness, applied in OKLab to every authored colour (one rotation, one
   scale and one shift per individual, so the body's pattern stays coherent). The authored sRGB hex is the
@@ -33,9 +33,9 @@ from typing import Any, Final
 import numpy as np
 import numpy.typing as npt
 
-from ..motion.trig import pcos, psin
 from ..spec.character import Genetics
-from .pose import lcg_next, mix_seed
+from .lcg import lcg_next, mix_seed
+from .trig import pcos, psin
 
 #: Draw index (1-based) of each gene; the gait genes follow GAIT_DRAW in gene-list order.
 HUE_DRAW: Final = 3
