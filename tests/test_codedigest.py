@@ -28,7 +28,7 @@ def test_the_surface_runs_its_own_closure_and_not_the_package_writer_or_the_lab(
         "creaturegen.surface.posed",  # imported by build
         "creaturegen.surface.frames",  # imported inside a function
         "creaturegen.motion.envelope",
-        "creaturegen.creature.genome",
+        "creaturegen.model.genome",
         "creaturegen.field",  # a package's __init__ runs before its modules
     } <= closure
     for outside in ("creaturegen.lab.picture", "creaturegen.creature.build", "creaturegen.cli"):
@@ -47,7 +47,7 @@ def _edit(path: Path, old: str, new: str) -> None:
 
 def test_prose_keeps_the_digest_and_code_changes_it(copy: Path) -> None:
     before = {e: code_digest(e, copy) for e in (SURFACE_ENTRY, ENVELOPE)}
-    genome = copy / "creature" / "genome.py"
+    genome = copy / "model" / "genome.py"
     # A comment, a docstring and a blank line in a module both stages run: nothing changes.
     _edit(genome, "HUE_DRAW: Final = 3", "# a comment\n\nHUE_DRAW: Final = 3  # and another")
     text = genome.read_text()

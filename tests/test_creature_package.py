@@ -29,6 +29,7 @@ from creaturegen.emit.render import to_json
 from creaturegen.emit.writer import header_text
 from creaturegen.field.primitives import slot_uses_round_cone
 from creaturegen.model import layout as col
+from creaturegen.model import lcg as lcg_module
 from creaturegen.model.genome import draw_genome, genetics_data, genome_colours, slot_lab
 from creaturegen.model.skeleton import build_skeleton
 from creaturegen.motion.providers import AnalyticWater
@@ -424,7 +425,7 @@ def python_reference(spec_path: Path) -> dict[str, Any]:
     for seed in SEEDS:
         state, draws = seed % (1 << 32), []
         for _ in range(LCG_DRAWS):
-            state = lcg.lcg_next(state)
+            state = lcg_module.lcg_next(state)
             draws.append(state)
         lcg.append({"seed": seed, "draws": draws})
     cases = []
@@ -447,12 +448,13 @@ def python_reference(spec_path: Path) -> dict[str, Any]:
         "slotCount": rig.slot_count,
         "constants": {
             "poseRows": pose_module.POSE_ROWS,
-            "lcg": {"a": lcg.LCG_A, "c": lcg.LCG_C},
+            "lcg": {"a": lcg_module.LCG_A, "c": lcg_module.LCG_C},
             "roundCone": [int(x) for x in slot_uses_round_cone(rig.slots)],
         },
         "lcg": lcg,
         "instances": [
-            {"seed": seed, "mixed": lcg.mix_seed(seed), "yaw": lcg.instance_yaw(seed)} for seed in SEEDS
+            {"seed": seed, "mixed": lcg_module.mix_seed(seed), "yaw": lcg_module.instance_yaw(seed)}
+            for seed in SEEDS
         ],
         "cases": cases,
         "frameCount": sum(len(c["frames"]) for c in cases),

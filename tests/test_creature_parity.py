@@ -115,20 +115,20 @@ def test_the_job_catches_a_wrong_skin_normal(
 @pytest.mark.browser
 def test_the_job_catches_a_baked_colour_that_drops_a_leaf(out_root: Path, tmp_path: Path) -> None:
     package = build_example("reference/hopper.json", out_root, "distant")
-    planted = _planted(
-        package,
-        tmp_path,
-        "field.js",
-        [
-            (
-                "for (let c = 0; c < 4; c++) {\n      const w = weights",
-                "for (let c = 0; c < 3; c++) {\n      const w = weights",
-            )
-        ],
+    swap = (
+        "for (let c = 0; c < 4; c++) {\n      const w = weights",
+        "for (let c = 0; c < 3; c++) {\n      const w = weights",
     )
-    report = run_creature_parity(planted, groups=("skin",))
-    failed = {g["name"] for g in report.gates if g["status"] == "fail"}
-    assert "drawn colour of skin-program vertices vs numpy baked colour" in failed, report.summary()
+    failed, summary = _failures(package, tmp_path, "field.js", [swap], ("skin",))
+    assert "drawn colour of skin-program vertices vs numpy baked colour" in failed, summary
+
+
+def _failures(
+    package: Path, tmp_path: Path, file: str, swaps: list[tuple[str, str]], groups: tuple[str, ...]
+) -> tuple[set[str], str]:
+    """The gates the job fails on a planted copy of ``package`` (see ``_planted``), and its summary."""
+    report = run_creature_parity(_planted(package, tmp_path, file, swaps), groups=groups)
+    return {g["name"] for g in report.gates if g["status"] == "fail"}, report.summary()
 
 
 def _planted(package: Path, tmp_path: Path, file: str, swaps: list[tuple[str, str]]) -> Path:
@@ -375,32 +375,24 @@ def test_the_job_catches_a_page_drawn_twice_in_a_pass(out_root: Path, tmp_path: 
     """A second mesh per page over the same geometry and material (an outline proxy, say) keeps the pages
     in use right but draws each page twice in the display pass: the draws-beyond-pages gate fails, and
     the pages-in-use gate stays quiet (the defect is in the draws, not in where bodies go)."""
-    package = build("reference/hopper.json", out_root)
-    planted = _planted(
-        package,
-        tmp_path,
-        "population.js",
-        [
-            (
-                "    page.mesh.material = materialFor(page, m);\n",
-                "    page.mesh.material = materialFor(page, m);\n"
-                "    if (!page.twin) {\n"
-                "      page.twin = new THREE.Mesh(geometry, null);\n"
-                "      page.twin.boundingSphere = page.mesh.boundingSphere;\n"
-                "      group.add(page.twin);\n"
-                "    }\n"
-                "    page.twin.material = page.mesh.material;\n",
-            ),
-            (
-                "    page.mesh.count = last + 1;\n",
-                "    page.mesh.count = last + 1;\n    if (page.twin) page.twin.count = page.mesh.count;\n",
-            ),
-        ],
+    twin = (
+        "    page.mesh.material = materialFor(page, m);\n",
+        "    page.mesh.material = materialFor(page, m);\n"
+        "    if (!page.twin) {\n"
+        "      page.twin = new THREE.Mesh(geometry, null);\n"
+        "      page.twin.boundingSphere = page.mesh.boundingSphere;\n"
+        "      group.add(page.twin);\n"
+        "    }\n"
+        "    page.twin.material = page.mesh.material;\n",
     )
-    report = run_creature_parity(planted, groups=("population",))
-    failed = {g["name"] for g in report.gates if g["status"] == "fail"}
-    assert "body draw calls in a render pass beyond pages in use (encoder count)" in failed, report.summary()
-    assert f"pose pages in use after {SPAWNS} spawns of pageSize {PAGE_SIZE}" not in failed, report.summary()
+    count = (
+        "    page.mesh.count = last + 1;\n",
+        "    page.mesh.count = last + 1;\n    if (page.twin) page.twin.count = page.mesh.count;\n",
+    )
+    package = build("reference/hopper.json", out_root)
+    failed, summary = _failures(package, tmp_path, "population.js", [twin, count], ("population",))
+    assert "body draw calls in a render pass beyond pages in use (encoder count)" in failed, summary
+    assert f"pose pages in use after {SPAWNS} spawns of pageSize {PAGE_SIZE}" not in failed, summary
 
 
 @pytest.mark.browser

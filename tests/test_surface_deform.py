@@ -19,9 +19,8 @@ import pytest
 
 from conftest import EXAMPLES, rest_surface
 from creaturegen.model import layout as col
-from creaturegen.model import rotations
-from creaturegen.model import skeleton as skeleton_ops
-from creaturegen.model.skeleton import Skeleton, build_skeleton
+from creaturegen.model.rotations import Pose, posed_slots, rotation_matrix
+from creaturegen.model.skeleton import Skeleton, build_skeleton, pose_joint, subtree
 from creaturegen.rig import CompiledRig
 from creaturegen.surface import deform
 from creaturegen.surface.field64 import BodyField
@@ -112,7 +111,7 @@ def examples() -> dict[str, tuple[Body, deform.DeformationChoice]]:
     return out
 
 
-def _skin(method: str, body: Body, pose: rotations.Pose, centers: F64) -> deform.Skinned:
+def _skin(method: str, body: Body, pose: Pose, centers: F64) -> deform.Skinned:
     v, n, i, w = body.mesh.vertices, body.normals, body.indices, body.weights
     if method == "lbs":
         return deform.skin_lbs(v, n, i, w, pose)
@@ -132,7 +131,7 @@ def _signed_volume(vertices: F64, faces: npt.NDArray[np.int32]) -> float:
 @pytest.mark.parametrize("method", deform.METHODS)
 def test_identity_pose_reproduces_rest_exactly(biped: Body, method: str) -> None:
     centers = deform.centers_of_rotation(biped.mesh, biped.indices, biped.weights)
-    skinned = _skin(method, biped, rotations.Pose.identity(biped.rig.slot_count), centers)
+    skinned = _skin(method, biped, Pose.identity(biped.rig.slot_count), centers)
     np.testing.assert_array_equal(skinned.positions, biped.mesh.vertices)
     np.testing.assert_allclose(skinned.normals, biped.normals, rtol=0, atol=1e-15)
     assert skinned.flips == 0
@@ -140,9 +139,9 @@ def test_identity_pose_reproduces_rest_exactly(biped: Body, method: str) -> None
 
 @pytest.mark.parametrize("method", deform.METHODS)
 def test_rigid_motion_of_the_whole_body_is_reproduced_by_every_method(biped: Body, method: str) -> None:
-    rotation = rotations.rotation_matrix([1.0, 2.0, 3.0], math.radians(137.0))
+    rotation = rotation_matrix([1.0, 2.0, 3.0], math.radians(137.0))
     translation = np.array([0.3, -1.2, 0.7])
-    pose = rotations.Pose.rigid(biped.rig.slot_count, rotation, translation)
+    pose = Pose.rigid(biped.rig.slot_count, rotation, translation)
     centers = deform.centers_of_rotation(biped.mesh, biped.indices, biped.weights)
     skinned = _skin(method, biped, pose, centers)
     expected = biped.mesh.vertices @ rotation.T + translation
@@ -154,9 +153,9 @@ def test_pose_joint_turns_the_subtree_about_its_pivot_and_leaves_the_rest(biped:
     skeleton, rest = biped.skeleton, biped.rig.slots
     knee = skeleton.names.index("part.leg-right[1]")
     hip = skeleton.parent[knee]
-    pose = skeleton_ops.pose_joint(skeleton, rest, hip, 0, math.radians(40.0), math.radians(25.0))
-    posed = rotations.posed_slots(rest, pose)
-    moved = skeleton_ops.subtree(skeleton, hip)
+    pose = pose_joint(skeleton, rest, hip, 0, math.radians(40.0), math.radians(25.0))
+    posed = posed_slots(rest, pose)
+    moved = subtree(skeleton, hip)
     assert np.flatnonzero(moved).tolist() == sorted([hip, knee])
     np.testing.assert_array_equal(posed[~moved], rest[~moved])
     for columns in (col.RA, col.RB, col.K, col.RGB):
@@ -164,9 +163,7 @@ def test_pose_joint_turns_the_subtree_about_its_pivot_and_leaves_the_rest(biped:
     pivot = skeleton.pivot[hip]
     np.testing.assert_allclose(pose.rotations[hip] @ pivot + pose.translations[hip], pivot, atol=1e-15)
     # A pure twist spins the child about its own axis: its ends, both on the axis, stay put.
-    twist = rotations.posed_slots(
-        rest, skeleton_ops.pose_joint(skeleton, rest, hip, 1, 0.0, math.radians(70.0))
-    )
+    twist = posed_slots(rest, pose_joint(skeleton, rest, hip, 1, 0.0, math.radians(70.0)))
     np.testing.assert_allclose(twist[hip, col.A], rest[hip, col.A], atol=1e-14)
     np.testing.assert_allclose(twist[hip, col.B], rest[hip, col.B], atol=1e-14)
 
@@ -214,8 +211,8 @@ def test_dq_antipodality_keeps_a_200_degree_blend_continuous(chain: Body) -> Non
     quaternions lie in opposite hemispheres and must be flipped to blend the short way."""
     pivot = chain.skeleton.pivot[1]
     axis = np.array([1.0, 0.0, 0.0])
-    rotations = np.stack([rotations.rotation_matrix(axis, math.radians(a)) for a in (100.0, -100.0)])
-    pose = rotations.Pose(rotations, pivot - rotations @ pivot)
+    rotations = np.stack([rotation_matrix(axis, math.radians(a)) for a in (100.0, -100.0)])
+    pose = Pose(rotations, pivot - rotations @ pivot)
     skinned = deform.skin_dq(chain.mesh.vertices, chain.normals, chain.indices, chain.weights, pose)
     assert skinned.flips > 0
     # Every blend of rotations about the pivot is a rotation about it: no vertex collapses.
@@ -241,7 +238,7 @@ def test_dq_antipodality_keeps_a_200_degree_blend_continuous(chain: Body) -> Non
     assert steps.max() < 1.5 * short_way / steps.size
     assert steps.sum() == pytest.approx(short_way, rel=1e-3)
     # The 50/50 blend sits at the 180° rotation (the short way), not back at rest (the long way).
-    halfway = pivot + rotations.rotation_matrix(axis, math.pi) @ (point - pivot)
+    halfway = pivot + rotation_matrix(axis, math.pi) @ (point - pivot)
     np.testing.assert_allclose(path[500], halfway, atol=1e-12)
 
 
@@ -258,9 +255,7 @@ def test_centers_of_rotation_sit_on_the_joint_axis(chain: Body) -> None:
 
 def test_skin_applies_each_vertex_its_joint_method(biped: Body) -> None:
     slot_count = biped.rig.slot_count
-    pose = skeleton_ops.pose_joint(
-        biped.skeleton, biped.rig.slots, 1, 0, math.radians(50.0), math.radians(20.0)
-    )
+    pose = pose_joint(biped.skeleton, biped.rig.slots, 1, 0, math.radians(50.0), math.radians(20.0))
     centers = deform.centers_of_rotation(biped.mesh, biped.indices, biped.weights)
     for method in deform.METHODS:
         mixed = deform.skin(
@@ -305,7 +300,7 @@ def test_every_example_joint_gets_a_method(
     json.dumps(choice.describe())
     # The chosen methods skin a sweep pose to finite positions and unit normals.
     _, child = body.skeleton.joints[0]
-    pose = skeleton_ops.pose_joint(body.skeleton, body.rig.slots, child, 1, math.radians(45.0), 0.0)
+    pose = pose_joint(body.skeleton, body.rig.slots, child, 1, math.radians(45.0), 0.0)
     skinned = deform.skin(
         body.mesh.vertices,
         body.normals,
@@ -428,9 +423,7 @@ def test_the_sweep_skins_its_seam_exactly_as_the_whole_mesh(biped: Body) -> None
 
     pair = (biped.indices, biped.weights)
     choice = biped.choose()
-    pose = skeleton_ops.pose_joint(
-        biped.skeleton, biped.rig.slots, 1, 0, math.radians(50.0), math.radians(20.0)
-    )
+    pose = pose_joint(biped.skeleton, biped.rig.slots, 1, 0, math.radians(50.0), math.radians(20.0))
     on_seam = seam(biped.skeleton, pair, 1)
     assert 0 < np.count_nonzero(on_seam) < biped.mesh.vertex_count // 2
     for method in deform.METHODS:

@@ -14,9 +14,8 @@ import numpy.typing as npt
 import pytest
 
 from conftest import rest_surface
-from creaturegen.model import rotations
-from creaturegen.model import skeleton as skeleton_ops
-from creaturegen.model.skeleton import Skeleton, build_skeleton
+from creaturegen.model.rotations import Pose, rotation_matrix
+from creaturegen.model.skeleton import Skeleton, build_skeleton, pose_joint
 from creaturegen.rig import CompiledRig
 from creaturegen.surface import deform, posed
 from creaturegen.surface.field64 import BodyField
@@ -50,14 +49,14 @@ class Chain:
         choice = Lbs(("lbs", "lbs"), np.zeros_like(self.mesh.vertices))
         return posed.choice_skinner(self.mesh, self.normals, pair, self.skeleton, choice)  # type: ignore[arg-type]
 
-    def quality(self, skin: posed.Skinner, pose: rotations.Pose, label: str) -> posed.PosedQuality:
+    def quality(self, skin: posed.Skinner, pose: Pose, label: str) -> posed.PosedQuality:
         none = np.zeros(self.mesh.vertex_count)
         return posed.posed_quality(
             self.rig, self.mesh, (self.indices, self.weights), skin, none, [pose], [label]
         )
 
-    def bend(self, degrees: float) -> rotations.Pose:
-        return skeleton_ops.pose_joint(self.skeleton, self.rig.slots, 1, 0, math.radians(degrees), 0.0)
+    def bend(self, degrees: float) -> Pose:
+        return pose_joint(self.skeleton, self.rig.slots, 1, 0, math.radians(degrees), 0.0)
 
 
 @pytest.fixture(scope="module")
@@ -128,8 +127,8 @@ def test_a_face_behind_another_sheet_is_not_seen() -> None:
 
 def test_rest_and_a_rigid_motion_of_the_whole_body_show_nothing(chain: Chain) -> None:
     skin = chain.skinner()
-    rotation = rotations.rotation_matrix([0.3, 1.0, -0.2], 1.1)
-    for pose in (rotations.Pose.identity(2), rotations.Pose.rigid(2, rotation, [0.4, -0.2, 0.9])):
+    rotation = rotation_matrix([0.3, 1.0, -0.2], 1.1)
+    for pose in (Pose.identity(2), Pose.rigid(2, rotation, [0.4, -0.2, 0.9])):
         q = chain.quality(skin, pose, "rigid").poses[0]
         # One transform moves every face: no pair's placement changed, so none is tested.
         assert (q.inverted, q.folds, q.crossing, q.creases, q.candidate_pairs) == (0, 0, 0, 0, 0)

@@ -22,9 +22,8 @@ from .. import __version__
 from ..candidates import TIERS, CandidateSet, TierRejectedError, build_candidates, skin_note
 from ..field.floors import floors_for
 from ..model import layout as col
-from ..model import rotations
-from ..model import skeleton as skeleton_ops
-from ..model.skeleton import Skeleton, build_skeleton
+from ..model.rotations import Pose, posed_slots
+from ..model.skeleton import Skeleton, build_skeleton, subtree
 from ..motion.envelope import PendingEnvelope, start_pose_envelope
 from ..rig import CompiledRig
 from ..rig.signatures import signatures as rig_signatures
@@ -260,7 +259,7 @@ def seam(skeleton: Skeleton, weights: tuple[npt.NDArray[np.int32], F64], child: 
     a swept limb passes through another part: interpenetration the sweep provokes, which no local
     correction can or should repair.
     """
-    moved = skeleton_ops.subtree(skeleton, child)
+    moved = subtree(skeleton, child)
     on_moved = np.where(moved[weights[0]], weights[1], 0.0).sum(axis=1)
     result: npt.NDArray[np.bool_] = (on_moved > SEAM_WEIGHT) & (on_moved < 1.0 - SEAM_WEIGHT)
     return result
@@ -276,7 +275,7 @@ def _skin_near(
     mesh: Mesh,
     normals: F64,
     weights: tuple[npt.NDArray[np.int32], F64],
-    pose: rotations.Pose,
+    pose: Pose,
     choice: deform.DeformationChoice,
     skeleton: Skeleton,
     on_seam: npt.NDArray[np.bool_],
@@ -311,7 +310,7 @@ def correction_sweep(
     skeleton: Skeleton,
     choice: deform.DeformationChoice,
     programs: npt.NDArray[np.int64],
-    motion_poses: tuple[rotations.Pose, ...] = (),
+    motion_poses: tuple[Pose, ...] = (),
 ) -> tuple[npt.NDArray[np.bool_], CorrectionReport, float, F64]:
     """Region policy and correction over each joint's extreme sweep poses and the motion's own poses.
 
@@ -346,7 +345,7 @@ def correction_sweep(
         if not on_seam.any():
             continue
         skinned = _skin_near(mesh, normals, weights, pose, choice, skeleton, on_seam)
-        posed_field = BodyField(rig.graph, rotations.posed_slots(rig.slots, pose))
+        posed_field = BodyField(rig.graph, posed_slots(rig.slots, pose))
         error = np.zeros(mesh.vertex_count)
         error[on_seam] = np.abs(posed_field.distance(skinned.positions[on_seam]))
         worst_skin = max(worst_skin, float(error.max()))
@@ -370,7 +369,7 @@ def _skin_departures(
     weights: SkinWeights,
     skeleton: Skeleton,
     choice: deform.DeformationChoice,
-    poses: tuple[rotations.Pose, ...],
+    poses: tuple[Pose, ...],
 ) -> tuple[BakedColour, Departures]:
     """Baked colour weights and how far the skin alone departs from the field (surface/skin_tier.py)."""
     k_floor = floors_for(rig.body_scale).k_floor

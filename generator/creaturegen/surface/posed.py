@@ -44,7 +44,7 @@ import numpy as np
 import numpy.typing as npt
 
 from ..field.primitives import primitive_distance
-from ..model import rotations
+from ..model.rotations import Pose, posed_slots
 from ..model.skeleton import Skeleton
 from ..rig import CompiledRig
 from . import deform
@@ -121,7 +121,7 @@ class PosedQuality:
 
 
 #: Positions and normals (V, 3) of every vertex skinned to a pose, each by its joint's method.
-Skinner = Callable[[rotations.Pose], tuple[F64, F64]]
+Skinner = Callable[[Pose], tuple[F64, F64]]
 
 
 def choice_skinner(
@@ -133,7 +133,7 @@ def choice_skinner(
 ) -> Skinner:
     """The build's skin: :func:`deform.skin` with the chosen methods."""
 
-    def skin(pose: rotations.Pose) -> tuple[F64, F64]:
+    def skin(pose: Pose) -> tuple[F64, F64]:
         s = deform.skin(
             mesh.vertices, normals, weights[0], weights[1], pose, choice.methods, skeleton, choice.centers
         )
@@ -143,12 +143,12 @@ def choice_skinner(
 
 
 def shipped_pose(
-    rig: CompiledRig, mesh: Mesh, skin: Skinner, radius: F64, pose: rotations.Pose
+    rig: CompiledRig, mesh: Mesh, skin: Skinner, radius: F64, pose: Pose
 ) -> tuple[F64, BodyField]:
     """The vertices as the runtime draws them at ``pose`` (skin, then the correction where ``radius`` >
     0), and the posed field they are measured against."""
     positions, skinned_normals = skin(pose)
-    field = BodyField(rig.graph, rotations.posed_slots(rig.slots, pose))
+    field = BodyField(rig.graph, posed_slots(rig.slots, pose))
     region = radius > 0
     if region.any():
         positions, _ = correct(field, mesh, positions, skinned_normals, region, radius)
@@ -234,7 +234,7 @@ def seen(posed: Mesh, faces: I64, outward: F64) -> Bools:
 
 
 def _rigid_groups(
-    weights: tuple[npt.NDArray[np.int32], F64], faces: npt.NDArray[np.integer], pose: rotations.Pose
+    weights: tuple[npt.NDArray[np.int32], F64], faces: npt.NDArray[np.integer], pose: Pose
 ) -> I64:
     """(F,) a face's rigid group at ``pose``: the class of slots sharing one transform that binds every
     corner wholly, or −1 where a corner blends transforms (a seam)."""
@@ -295,7 +295,7 @@ def pose_quality(
     weights: tuple[npt.NDArray[np.int32], F64],
     skin: Skinner,
     radius: F64,
-    pose: rotations.Pose,
+    pose: Pose,
     label: str,
     edges: I64,
     rest_turn: F64,
@@ -350,7 +350,7 @@ def posed_quality(
     weights: tuple[npt.NDArray[np.int32], F64],
     skin: Skinner,
     radius: F64,
-    poses: Sequence[rotations.Pose],
+    poses: Sequence[Pose],
     labels: Sequence[str],
 ) -> PosedQuality:
     """Every envelope pose measured (see the module docstring); ``radius`` is the runtime's correction

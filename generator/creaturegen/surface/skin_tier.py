@@ -31,7 +31,7 @@ from ..field.colour import proximity_weights
 from ..field.primitives import primitive_field
 from ..field.sampler import sample_graph
 from ..model import layout as col
-from ..model import rotations
+from ..model.rotations import Pose, posed_slots
 from ..model.skeleton import Skeleton
 from ..rig import CompiledRig
 from ..rig.colour import linear_to_oklab
@@ -99,7 +99,7 @@ def skin_departures(
     skeleton: Skeleton,
     choice: deform.DeformationChoice,
     colour: BakedColour,
-    poses: tuple[rotations.Pose, ...],
+    poses: tuple[Pose, ...],
     k_floor: float,
     on_seam: npt.NDArray[np.bool_],
 ) -> Departures:
@@ -116,11 +116,11 @@ def skin_departures(
     baked = baked_rgb(colour.slots, colour.weights, rig.slots[:, col.RGB])
     own = np.zeros((mesh.vertex_count, rig.slot_count), dtype=bool)
     np.put_along_axis(own, weights[0].astype(np.int64), weights[1] > 0.0, axis=1)
-    for pose in (rotations.Pose.identity(rig.slot_count), *poses):
+    for pose in (Pose.identity(rig.slot_count), *poses):
         skinned = deform.skin(
             mesh.vertices, normals, weights[0], weights[1], pose, choice.methods, skeleton, choice.centers
         )
-        table = rotations.posed_slots(rig.slots, pose)
+        table = posed_slots(rig.slots, pose)
         field = sample_graph(rig.graph, table, skinned.positions, k_floor)
         leaves, _ = primitive_field(table, skinned.positions)
         seen = ~((leaves.T < 0.0) & ~own).any(axis=1)

@@ -2845,7 +2845,7 @@ export const CREATURE = Object.freeze({
     0
   ],
   "signatures": {
-    "compilerSignature": "36a33be9549746c9ff5c9d8054e10cafeef94b11bc6aece89e32a50e6f76372a",
+    "compilerSignature": "d680a52331fd4516e6c4cf30219149a0e16bdc2cb8aef1381ac14edf79676585",
     "geometryDigest": "400b0d18a2a9f6bbbfe5b441f89767f552a4f3b4c45a368d1129d632e1d2f4f1",
     "topologySignature": "330d551e8c006f84b01459c84db69ca8c43aec5bc9d9083d3e85c291be5a68bf"
   },
