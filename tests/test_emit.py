@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import json
 import math
 import stat
 from pathlib import Path
@@ -10,7 +11,7 @@ import pytest
 
 from creaturegen import __version__
 from creaturegen.emit import PackageFile, PackageWriteError, header_for, write_package
-from creaturegen.emit.render import to_json
+from creaturegen.emit.render import DATA_WIDTH, data_json, to_json
 
 SHA = "ab" * 32
 
@@ -145,3 +146,20 @@ def test_conflicting_paths_are_a_package_write_error(tmp_path: Path) -> None:
     with pytest.raises(PackageWriteError):
         write_package(tmp_path, "pkg", [PackageFile("core", b"x"), PackageFile("core/plan.js", b"y")])
     assert list(tmp_path.iterdir()) == []
+
+
+def test_data_json_round_trips_and_packs_numbers_into_lines() -> None:
+    """Bulk data (core/data.js): the value json.loads gives back is exactly the one dumped (floats by
+    their shortest round-trip repr, as to_json), keys sorted, no line past DATA_WIDTH, and a long run
+    of numbers takes a few lines instead of one per number."""
+    tape = [0.1 + 0.2, -3e-7, 1e300, 5e-324, 2.0, -0.0] * 200
+    value = {"z": tape, "a": {"empty": [], "none": {}, "pairs": [[1, 2], [3.5, None]], "name": "x\u00e9"}}
+    text = data_json(value)
+    assert json.loads(text) == value
+    assert [float(x).hex() for x in json.loads(text)["z"]] == [x.hex() for x in tape]
+    assert text.index('"a"') < text.index('"z"')
+    assert max(len(line) for line in text.splitlines()) <= DATA_WIDTH
+    assert len(text.splitlines()) < len(tape) / 8
+    assert data_json(value) == text
+    with pytest.raises(ValueError, match="JSON"):
+        data_json({"bad": [math.nan]})

@@ -21,6 +21,48 @@ def to_json(value: Any, indent: int | None = 2) -> str:
     return json.dumps(value, indent=indent, sort_keys=True, ensure_ascii=True, allow_nan=False)
 
 
+#: Widest line of a wrapped run of numbers in data_json (indent included).
+DATA_WIDTH = 110
+
+
+def _scalar(value: Any) -> str:
+    return json.dumps(value, ensure_ascii=True, allow_nan=False)
+
+
+def data_json(value: Any, indent: int = 2, width: int = DATA_WIDTH) -> str:
+    """``to_json`` for bulk data: the same sorted keys and shortest round-trip numbers (``json.loads``
+    gives back exactly the same value), but a list of scalars is packed onto as few lines as fit
+    ``width`` instead of one number per line. A program tape of thousands of numbers reads as a block."""
+
+    def dump(v: Any, level: int) -> str:
+        pad, inner = " " * (indent * level), " " * (indent * (level + 1))
+        if isinstance(v, dict):
+            if not v:
+                return "{}"
+            rows = [f"{inner}{_scalar(str(k))}: {dump(v[k], level + 1)}" for k in sorted(v)]
+            return "{\n" + ",\n".join(rows) + "\n" + pad + "}"
+        if isinstance(v, list | tuple):
+            if not v:
+                return "[]"
+            if any(isinstance(x, dict | list | tuple) for x in v):
+                return "[\n" + ",\n".join(inner + dump(x, level + 1) for x in v) + "\n" + pad + "]"
+            items = [_scalar(x) for x in v]
+            if len(pad) + sum(len(i) + 2 for i in items) <= width:
+                return "[" + ", ".join(items) + "]"
+            lines: list[str] = []
+            line = ""
+            for item in items:
+                if line and len(inner) + len(line) + len(item) + 2 > width:
+                    lines.append(inner + line.rstrip())
+                    line = ""
+                line += item + ", "
+            lines.append(inner + line.rstrip(", "))
+            return "[\n" + ",\n".join(row.rstrip(",") for row in lines) + "\n" + pad + "]"
+        return _scalar(v)
+
+    return dump(value, 0)
+
+
 #: Characters Markdown or HTML would act on in a README (emphasis, links, images, headings, tables, raw
 #: HTML, entities): a spec's name is shown as the text it is, never as markup.
 _MARKDOWN_ACTIVE = frozenset("\\`*_{}[]()<>#!|&~\"'")
@@ -50,6 +92,7 @@ def environment(folder: Path) -> jinja2.Environment:
         lstrip_blocks=True,
     )
     env.filters["tojson_sorted"] = to_json
+    env.filters["tojson_data"] = data_json
     env.filters["markdown_text"] = markdown_text
     return env
 
