@@ -397,6 +397,28 @@ def test_every_runtime_export_is_typed(hopper: Path, site: Path) -> None:
     assert package["types"] == package["exports"]["."]["types"]
 
 
+def test_the_string_unions_are_the_python_definitions(hopper: Path) -> None:
+    """DebugMode, TierName and LocomotionType in core/index.d.ts are rendered from the values the
+    runtime data and the spec gate use, not written out a second time."""
+    from creaturegen.candidates import TIERS
+    from creaturegen.creature.plan import DEBUG_MODES
+    from creaturegen.spec.character import LocomotionType
+
+    text = (hopper / "core" / "index.d.ts").read_text()
+    for name, values in (
+        ("DebugMode", DEBUG_MODES),
+        ("TierName", tuple(TIERS)),
+        ("LocomotionType", typing.get_args(LocomotionType)),
+    ):
+        union = re.search(rf"^export type {name} = (.+);$", text, re.M)
+        assert union is not None, name
+        assert [json.loads(v) for v in union.group(1).split(" | ")] == list(values), name
+    runtime = json.loads(
+        re.sub(r"^[^{]*|\);\s*$", "", (hopper / "core" / "data.js").read_text().split("Object.freeze(", 1)[1])
+    )
+    assert runtime["debugModes"] == list(DEBUG_MODES)
+
+
 def top_level(text: str) -> str:
     """``text`` with everything inside (), [], {} and <> removed: the members of one interface body."""
     out, depth = [], 0
@@ -453,7 +475,7 @@ def test_creature_data_is_typed_field_for_field(hopper: Path) -> None:
         assert interface_members(dts, interface) == fields, interface
     union = re.search(r"export type LocomotionType = ([^;]+);", dts.read_text())
     assert union
-    assert set(re.findall(r"'([a-z]+)'", union.group(1))) == set(typing.get_args(LocomotionType))
+    assert set(re.findall(r"[\"']([a-z]+)[\"']", union.group(1))) == set(typing.get_args(LocomotionType))
 
 
 def test_types_peer_and_three_pin_are_declared(hopper: Path) -> None:

@@ -9,12 +9,12 @@ makes the lab-vs-numpy parity job meaningful.
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, get_args
 
 import numpy as np
 
 from .. import __version__
-from ..candidates import CandidateSet, TierRejectedError, build_candidates
+from ..candidates import TIERS, CandidateSet, TierRejectedError, build_candidates
 from ..field.floors import floors_for
 from ..field.primitives import GRADIENT_FLOOR, slot_uses_round_cone
 from ..model import layout as col
@@ -24,6 +24,7 @@ from ..model.skeleton import Skeleton, build_skeleton
 from ..motion.rig import build_motion
 from ..rig import CompiledRig
 from ..spec import CharacterSpec, slugify
+from ..spec.character import LocomotionType
 from ..surface import correct as correction
 from ..surface.build import NO_PROGRAM, SKIN_PROGRAM, SurfaceBuild
 from ..surface.deform import METHODS
@@ -197,5 +198,11 @@ def build_plan(
             "deformBytesPerBody": asset.vertex_count * DEFORM_STRIDE * 16,
         },
         "methods": {m: int(np.count_nonzero(skin[:, 0] == i)) for i, m in enumerate(METHODS)},
+        # The string unions of core/index.d.ts, from the Python definitions the runtime data comes from.
+        "types": {
+            "debugMode": list(DEBUG_MODES),
+            "tierName": list(TIERS),
+            "locomotionType": list(get_args(LocomotionType)),
+        },
     }
     return CreaturePlan(plan, tuple(tapes), skeleton)

@@ -4,9 +4,9 @@
 
 type Vec = ArrayLike<number> & { [index: number]: number };
 
-export type DebugMode = 'off' | 'skin-only' | 'distance' | 'weights' | 'normals' | 'candidates' | 'shell';
-export type TierName = 'hero' | 'repeated' | 'distant';
-export type LocomotionType = 'none' | 'biped' | 'quadruped' | 'hexapod' | 'octopod' | 'walker' | 'hopper' | 'flyer' | 'swimmer';
+export type DebugMode = "off" | "skin-only" | "distance" | "weights" | "normals" | "candidates" | "shell";
+export type TierName = "hero" | "repeated" | "distant";
+export type LocomotionType = "none" | "biped" | "quadruped" | "hexapod" | "octopod" | "walker" | "hopper" | "flyer" | "swimmer";
 export type Vec3 = [number, number, number];
 
 /** The LCG every instance stream uses: state' = (a·state + c) mod 2^32. */
