@@ -182,3 +182,29 @@ def test_the_band_tells_a_crease_of_the_hard_union_from_skin_off_the_body(chain:
         ]
     )
     np.testing.assert_array_equal(posed.off_band(field, points, tol), [False, True, True])
+
+
+def test_pruning_moved_together_subtrees_keeps_exactly_the_wanted_pairs(chain: Chain) -> None:
+    """candidate_pairs with groups skips whole subtrees of the BVH whose faces moved together; the pairs
+    it keeps are exactly those of a full traversal with the same-group pairs dropped afterwards."""
+    from creaturegen.surface.intersect import candidate_pairs, refit, triangle_boxes, triangle_bvh
+
+    pose = chain.bend(70.0)
+    positions, _ = chain.skinner()(pose)
+    posed_mesh = Mesh(positions, chain.mesh.faces)
+    groups = posed._rigid_groups((chain.indices, chain.weights), chain.mesh.faces, pose)
+    assert (groups >= 0).any()
+    assert (groups < 0).any()
+    tree = refit(triangle_bvh(chain.mesh, leaf_size=2), *triangle_boxes(posed_mesh.corners()))
+
+    def pairs(g: npt.NDArray[np.int64] | None) -> set[tuple[int, int]]:
+        return {
+            (min(a, b), max(a, b))
+            for i, j in candidate_pairs(tree, posed_mesh.faces, g)
+            for a, b in zip(i.tolist(), j.tolist(), strict=True)
+        }
+
+    everything = pairs(None)
+    wanted = {(a, b) for a, b in everything if groups[a] < 0 or groups[a] != groups[b]}
+    assert pairs(groups) == wanted
+    assert 0 < len(wanted) < len(everything)

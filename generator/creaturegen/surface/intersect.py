@@ -159,16 +159,39 @@ def _overlapping(lo: F64, hi: F64, a: I64, b: I64) -> tuple[I64, I64]:
     return a, b
 
 
-def overlapping_leaf_pairs(bvh: BVH) -> tuple[I64, I64]:
+def node_groups(bvh: BVH, groups: I64) -> I64:
+    """(nodes,) the group every primitive under a node shares (≥ 0), or −1 where they differ or one of
+    them has none: a node whose primitives all moved together."""
+    valid = bvh.leaves >= 0
+    leaf = np.where(valid, groups[np.maximum(bvh.leaves, 0)], -2)
+    first = leaf[:, 0]
+    uniform = np.all((leaf == first[:, None]) | ~valid, axis=1) & (first >= 0)
+    out = np.full(bvh.lo.shape[0], -1, dtype=np.int64)
+    top = (1 << bvh.depth) - 1
+    out[top:] = np.where(uniform, first, -1)
+    for d in range(bvh.depth - 1, -1, -1):
+        parents = np.arange((1 << d) - 1, (1 << (d + 1)) - 1)
+        left, right = out[2 * parents + 1], out[2 * parents + 2]
+        out[parents] = np.where(left == right, left, -1)
+    return out
+
+
+def overlapping_leaf_pairs(bvh: BVH, groups: I64 | None = None) -> tuple[I64, I64]:
     """Leaf pairs (a ≤ b, within-level ids) whose boxes overlap, by a breadth-first dual traversal.
 
     A pair (a, a) expands to its three child pairs (l,l), (l,r), (r,r); a pair a < b to all four, which
-    keeps every unordered pair exactly once.
+    keeps every unordered pair exactly once. With ``groups`` (per node, :func:`node_groups`), a pair of
+    nodes whose primitives all share one group is not expanded: no pair under it is wanted.
     """
     a = np.zeros(1, dtype=np.int64)
     b = np.zeros(1, dtype=np.int64)
     lo, hi = np.ascontiguousarray(bvh.lo.T).T, np.ascontiguousarray(bvh.hi.T).T
     for d in range(bvh.depth):
+        if groups is not None:
+            here = (1 << d) - 1
+            ga, gb = groups[a + here], groups[b + here]
+            wanted = (ga < 0) | (ga != gb)
+            a, b = a[wanted], b[wanted]
         same = a == b
         sa, da, db = a[same], a[~same], b[~same]
         na = np.concatenate([2 * sa, 2 * sa, 2 * sa + 1, 2 * da, 2 * da, 2 * da + 1, 2 * da + 1])
@@ -185,12 +208,10 @@ def candidate_pairs(
     """Batches of face pairs (i, j), each unordered pair once, whose AABBs overlap and that share no
     vertex index. With ``groups`` (F,), pairs of faces in one group ≥ 0 are left out, whole leaf pairs
     first: faces a pose moved together (surface/posed.py)."""
-    la, lb = overlapping_leaf_pairs(bvh)
-    if groups is not None:
-        leaf_group = np.where(bvh.leaves >= 0, groups[np.maximum(bvh.leaves, 0)], -2)
-        one = np.where(
-            np.all((leaf_group == leaf_group[:, :1]) | (leaf_group == -2), axis=1), leaf_group[:, 0], -1
-        )
+    tree_groups = None if groups is None else node_groups(bvh, groups)
+    la, lb = overlapping_leaf_pairs(bvh, tree_groups)
+    if tree_groups is not None:
+        one = tree_groups[(1 << bvh.depth) - 1 :]
         keep = (one[la] < 0) | (one[la] != one[lb])
         la, lb = la[keep], lb[keep]
     m = bvh.leaves.shape[1]

@@ -186,6 +186,17 @@ def winding_numbers(mesh: Mesh, points: F64) -> I64:
     cells = int(extent / cell) + 2
     first = np.floor((lo - origin) / cell).astype(np.int64)
     last = np.floor((hi - origin) / cell).astype(np.int64)
+    # Only faces over a cell some point falls in can be crossed by its ray: bin those alone.
+    qc = np.floor((p[:, :2] - origin) / cell).astype(np.int64)
+    wanted = np.zeros((cells, cells), dtype=bool)
+    inside = np.all((qc >= 0) & (qc < cells), axis=1)
+    wanted[qc[inside, 0], qc[inside, 1]] = True
+    covered = np.cumsum(np.cumsum(np.pad(wanted, ((1, 0), (1, 0))), axis=0, dtype=np.int32), axis=1)
+    f0, f1 = np.clip(first, 0, cells - 1), np.clip(last, 0, cells - 1) + 1
+    hits = covered[f1[:, 0], f1[:, 1]] - covered[f0[:, 0], f1[:, 1]] - covered[f1[:, 0], f0[:, 1]]
+    hits += covered[f0[:, 0], f0[:, 1]]
+    near = np.flatnonzero(hits > 0)
+    c, first, last = c[near], first[near], last[near]
     span = last - first + 1
     count = span[:, 0] * span[:, 1]
     face = np.repeat(np.arange(c.shape[0]), count)
@@ -195,8 +206,6 @@ def winding_numbers(mesh: Mesh, points: F64) -> I64:
     key = cx * cells + cy
     order = np.argsort(key, kind="stable")
     key, face = key[order], face[order]
-    qc = np.floor((p[:, :2] - origin) / cell).astype(np.int64)
-    inside = np.all((qc >= 0) & (qc < cells), axis=1)
     qkey = np.where(inside, qc[:, 0] * cells + qc[:, 1], -1)
     start = np.searchsorted(key, qkey, side="left")
     stop = np.where(inside, np.searchsorted(key, qkey, side="right"), start)
@@ -254,23 +263,28 @@ def _rigid_groups(
 
 def _crossings(posed: Mesh, groups: I64, rest_bvh: BVH) -> tuple[I64, int]:
     """(crossing pairs (N, 2), pairs tested) among the faces the pose moved relative to each other; the
-    rest mesh's tree refitted to the pose serves as the broad phase."""
+    rest mesh's tree refitted to the pose serves as the broad phase, and the exact plane signs are
+    taken only for the faces some candidate pair holds."""
     corners = posed.corners()
-    signs, _ = normal_signs(corners)
-    flat = np.all(signs == 0, axis=1)
-    tested = 0
-    found = [np.zeros((0, 2), dtype=np.int64)]
     tree = refit(rest_bvh, *triangle_boxes(corners))
-    for i, j in candidate_pairs(tree, posed.faces, groups):
-        keep = ~flat[i] & ~flat[j]
-        i, j = i[keep], j[keep]
-        tested += int(i.size)
-        for s in range(0, i.size, PAIR_CHUNK):
-            bi, bj = i[s : s + PAIR_CHUNK], j[s : s + PAIR_CHUNK]
-            verdict = triangle_pairs(corners[bi], corners[bj], signs[bi])
-            hit = verdict.hit & ~verdict.coplanar
-            found.append(np.stack([bi[hit], bj[hit]], axis=1))
-    return np.concatenate(found), tested
+    batches = list(candidate_pairs(tree, posed.faces, groups))
+    found = [np.zeros((0, 2), dtype=np.int64)]
+    if not batches:
+        return found[0], 0
+    i = np.concatenate([b[0] for b in batches])
+    j = np.concatenate([b[1] for b in batches])
+    faces, local = np.unique(np.concatenate([i, j]), return_inverse=True)
+    signs, _ = normal_signs(corners[faces])
+    flat = np.all(signs == 0, axis=1)
+    li, lj = local[: i.size], local[i.size :]
+    keep = ~flat[li] & ~flat[lj]
+    i, j, li = i[keep], j[keep], li[keep]
+    for s in range(0, i.size, PAIR_CHUNK):
+        bi, bj = i[s : s + PAIR_CHUNK], j[s : s + PAIR_CHUNK]
+        verdict = triangle_pairs(corners[bi], corners[bj], signs[li[s : s + PAIR_CHUNK]])
+        hit = verdict.hit & ~verdict.coplanar
+        found.append(np.stack([bi[hit], bj[hit]], axis=1))
+    return np.concatenate(found), int(i.size)
 
 
 def off_band(field: BodyField, points: F64, tolerance: float) -> Bools:
