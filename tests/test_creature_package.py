@@ -11,6 +11,7 @@ import hashlib
 import importlib.util
 import json
 import re
+import shutil
 import subprocess
 import sys
 from pathlib import Path
@@ -513,3 +514,20 @@ def test_golden_record(hopper: Path) -> None:
     manifest = json.loads(stored[golden.BINARY_MANIFEST])
     assert set(manifest["files"]) == {surface_path(hopper).relative_to(hopper).as_posix()}
     assert any(name.startswith("package/core/") for name in stored)
+
+
+def test_the_golden_record_catches_a_template_copy_the_build_altered(hopper: Path, tmp_path: Path) -> None:
+    """Files the build copies verbatim are named in verbatim.json instead of stored; a build whose copy is
+    no longer the template's bytes (here: one line appended) no longer matches the record, by name."""
+    golden = regen_golden()
+    stored = golden.stored("creature-hopper")
+    copies = json.loads(stored[golden.VERBATIM_MANIFEST])["files"]
+    assert "core/hash.js" in copies
+    assert "package/core/hash.js" not in stored
+    altered = tmp_path / hopper.name
+    shutil.copytree(hopper, altered)
+    hashjs = altered / "core" / "hash.js"
+    hashjs.write_bytes(hashjs.read_bytes() + b"// extra\n")
+    diff = golden.differences(stored, golden.record(altered))
+    assert any(line.startswith("package/core/hash.js: in the build, not in the record") for line in diff)
+    assert any(line.startswith("verbatim.json") for line in diff), diff

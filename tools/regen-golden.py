@@ -6,7 +6,11 @@
 
 A record is ``tests/golden/<case>/package/<file>`` for every generated text file of the package, exactly
 as built, plus ``tests/golden/<case>/binary-sha256.json`` naming the size and sha256 of each binary file
-(the .glb), so the record stays reviewable and small. tests/test_creature_package.py rebuilds the package
+(the .glb), so the record stays reviewable and small. A file the build copies from its template verbatim
+(the generated-code header, then the template's bytes) is not stored a second time: ``verbatim.json``
+names it with its header line, and a build that stops copying it verbatim no longer matches the record.
+So a hand edit to a plain JS template needs no new record; a rendered (``.j2``) file still does.
+tests/test_creature_package.py rebuilds the package
 and compares it with the record; the record changes legitimately whenever a template or the compiler
 does, and then this script is the one command to run (review the diff, commit tests/golden/).
 
@@ -33,6 +37,8 @@ GOLDEN = REPO / "tests" / "golden"
 CASES = {"creature-hopper": "examples/reference/hopper.json"}
 PACKAGE = "package"
 BINARY_MANIFEST = "binary-sha256.json"
+VERBATIM_MANIFEST = "verbatim.json"
+TEMPLATES = REPO / "generator" / "creaturegen" / "templates"
 #: Files stored as they are; anything else is recorded by size and sha256.
 TEXT_SUFFIXES = (".js", ".mjs", ".ts", ".md", ".json")
 REGENERATE = "make golden"
@@ -61,19 +67,40 @@ def binary_entry(content: bytes) -> dict[str, object]:
     return {"bytes": len(content), "sha256": hashlib.sha256(content).hexdigest()}
 
 
+def _verbatim_header(content: bytes, template: Path) -> str | None:
+    """The header line when ``content`` is ``template`` copied as it is (after an optional generated-code
+    header line), else None."""
+    if not template.is_file():
+        return None
+    source = template.read_bytes()
+    if content == source:
+        return ""
+    first, _, rest = content.partition(b"\n")
+    return first.decode() if rest == source and first.startswith(b"// Code generated") else None
+
+
 def record(package: Path) -> dict[str, bytes]:
     """The record of a built package: ``{path under tests/golden/<case>/: bytes}``."""
+    kind = json.loads((package / "build-report.json").read_text())["kind"]
     files: dict[str, bytes] = {}
     binaries: dict[str, object] = {}
+    verbatim: dict[str, str] = {}
     for path in sorted(p for p in package.rglob("*") if p.is_file()):
         relative = path.relative_to(package).as_posix()
         content = path.read_bytes()
         if path.suffix in TEXT_SUFFIXES:
-            files[f"{PACKAGE}/{relative}"] = content
+            header = _verbatim_header(content, TEMPLATES / kind / relative)
+            if header is None:
+                files[f"{PACKAGE}/{relative}"] = content
+            else:
+                verbatim[relative] = header
         else:
             binaries[relative] = binary_entry(content)
-    manifest = {"//": f"Written by tools/regen-golden.py; run `{REGENERATE}` to update.", "files": binaries}
+    note = f"Written by tools/regen-golden.py; run `{REGENERATE}` to update."
+    manifest = {"//": note, "files": binaries}
     files[BINARY_MANIFEST] = (json.dumps(manifest, indent=2, sort_keys=True) + "\n").encode()
+    copies = {"//": note + f" Each file is templates/{kind}/<path> after its header line.", "files": verbatim}
+    files[VERBATIM_MANIFEST] = (json.dumps(copies, indent=2, sort_keys=True) + "\n").encode()
     return files
 
 
