@@ -145,7 +145,6 @@ def test_a_started_envelope_is_the_measured_one_and_stops_when_left(
     leaves no worker running."""
     monkeypatch.setenv("CREATUREGEN_CACHE", str(tmp_path))
     monkeypatch.setenv(envelope.WORKERS_ENV, "2")
-    monkeypatch.setattr(envelope, "_MEMORY", {})
     spec, rig, data, skeleton = _load("reference/flyer.json")
     with envelope.start_pose_envelope(spec, rig) as pending:
         pool = pending._pool
@@ -155,7 +154,6 @@ def test_a_started_envelope_is_the_measured_one_and_stops_when_left(
     assert started == envelope._to_json(envelope.measure_envelope(data, rig.slots, skeleton))
     assert not any(w.is_alive() for w in workers)
 
-    monkeypatch.setattr(envelope, "_MEMORY", {})
     monkeypatch.setenv("CREATUREGEN_CACHE", str(tmp_path / "other"))
     with envelope.start_pose_envelope(spec, rig) as pending:
         workers = list(pending._pool._pool)

@@ -5,7 +5,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 from ..field.floors import floors_for
-from ..motion.envelope import pose_envelope
+from ..motion.envelope import PoseEnvelope, pose_envelope
 from ..rig import CompiledRig
 from ..spec import CharacterSpec
 from .program import CandidateProgram, Certificate
@@ -76,13 +76,18 @@ def skin_note(tier: str) -> str:
     )
 
 
-def build_candidates(spec: CharacterSpec, rig: CompiledRig, tier: str) -> CandidateSet:
-    """Programs for every region, certified and swept; TierRejectedError names what could not be bounded."""
+def build_candidates(
+    spec: CharacterSpec, rig: CompiledRig, tier: str, envelope: PoseEnvelope | None = None
+) -> CandidateSet:
+    """Programs for every region, certified and swept; TierRejectedError names what could not be bounded.
+    ``envelope`` is the motion envelope when the caller has it (the surface build does), else it is
+    measured or read from its disk cache."""
     chosen = TIERS[tier]
     if chosen.skin is not None:
         raise TierRejectedError(skin_note(tier))
     tol = tolerances(rig)
-    envelope = pose_envelope(spec, rig)
+    if envelope is None:
+        envelope = pose_envelope(spec, rig)
     found = search(rig, envelope.slot_excursion, chosen, tol)
     programs = found.programs
     result = run_sweep(rig, programs, envelope.slot_excursion, envelope.poses, tol.band, tol.k_floor)

@@ -460,13 +460,11 @@ def _from_json(text: str) -> PoseEnvelope:
     )
 
 
-_MEMORY: dict[str, PoseEnvelope] = {}
-
-
 def pose_envelope(spec: CharacterSpec, rig: CompiledRig) -> PoseEnvelope:
-    """The envelope of ``spec``'s motion. Stepping every run takes seconds and the candidate stage, the
-    surface stage and the plan all ask, so it is kept in memory and on disk beside the surface cache,
-    keyed by the motion data, the rest slots and the generator's sources (floats round-trip exactly)."""
+    """The envelope of ``spec``'s motion. Stepping every run takes seconds, so it is kept on disk beside
+    the surface cache, keyed by the motion data, the rest slots and the code of this stage (floats
+    round-trip exactly). The surface build hands the envelope it measured to the candidate stage; no
+    module keeps one in memory."""
     with start_pose_envelope(spec, rig) as pending:
         return pending.result()
 
@@ -526,28 +524,27 @@ class PendingEnvelope:
             staging = path.with_suffix(f".{os.getpid()}.tmp")
             staging.write_text(_to_json(envelope))
             staging.replace(path)
-            _MEMORY[self._key] = envelope
             self._ready = envelope
         return self._ready
 
 
-def start_pose_envelope(spec: CharacterSpec, rig: CompiledRig) -> PendingEnvelope:
+def start_pose_envelope(
+    spec: CharacterSpec, rig: CompiledRig, skeleton: Skeleton | None = None
+) -> PendingEnvelope:
     """``pose_envelope`` started: from memory or disk when there, else its runs stepping in forked workers
     (where fork and more than one CPU are available) until ``result()`` is asked. It must be started
     before anything starts a GPU device's threads (forking after that is unsafe); a spec whose motion
-    cannot be stepped raises MotionRangeError here, before any work."""
-    skeleton = build_skeleton(spec, rig)
+    cannot be stepped raises MotionRangeError here, before any work. ``skeleton`` is the caller's when it
+    has built one."""
+    if skeleton is None:
+        skeleton = build_skeleton(spec, rig)
     data = build_motion(spec, rig, skeleton)
     key = hashlib.sha256(
         json.dumps(data, sort_keys=True).encode()
         + rig.slots.tobytes()
         + stage_digest("creaturegen.motion.envelope").encode()
     ).hexdigest()
-    if key in _MEMORY:
-        return PendingEnvelope(key, _MEMORY[key])
     path = default_cache_root() / "envelope" / f"{key}.json"
     if path.is_file():
-        envelope = _from_json(path.read_text())
-        _MEMORY[key] = envelope
-        return PendingEnvelope(key, envelope)
+        return PendingEnvelope(key, _from_json(path.read_text()))
     return PendingEnvelope(key, None, (data, rig.slots, skeleton))

@@ -24,7 +24,7 @@ from ..field.floors import floors_for
 from ..model import layout as col
 from ..model.rotations import Pose, posed_slots
 from ..model.skeleton import Skeleton, build_skeleton, subtree
-from ..motion.envelope import PendingEnvelope, start_pose_envelope
+from ..motion.envelope import PendingEnvelope, PoseEnvelope, start_pose_envelope
 from ..rig import CompiledRig
 from ..rig.signatures import signatures as rig_signatures
 from ..spec import CharacterSpec
@@ -229,10 +229,12 @@ def choose_backend(
     return chosen, why
 
 
-def tier_candidates(spec: CharacterSpec, rig: CompiledRig, tier: str) -> CandidateSet | str:
+def tier_candidates(
+    spec: CharacterSpec, rig: CompiledRig, tier: str, envelope: PoseEnvelope | None = None
+) -> CandidateSet | str:
     """The tier's candidate programs, or why the tier has none (TierRejectedError's message)."""
     try:
-        return build_candidates(spec, rig, tier)
+        return build_candidates(spec, rig, tier, envelope)
     except TierRejectedError as exc:
         return str(exc)
 
@@ -1010,8 +1012,9 @@ def _extract_surface(
     The motion envelope is started first: its runs step in forked workers (motion/envelope.py) while this
     process samples, extracts and gates the mesh, which needs no motion; forking is safe only before the
     sampling backend has started a GPU device's threads. The skin weights are the first to wait for it."""
-    with start_pose_envelope(spec, rig) as pending:
-        return _extract_with(spec, rig, key, tier, backend, cache, progress, strict, pending)
+    skeleton = build_skeleton(spec, rig)
+    with start_pose_envelope(spec, rig, skeleton) as pending:
+        return _extract_with(spec, rig, key, tier, backend, cache, progress, strict, pending, skeleton)
 
 
 def _extract_with(
@@ -1024,13 +1027,13 @@ def _extract_with(
     progress: Progress,
     strict: bool,
     pending: PendingEnvelope,
+    skeleton: Skeleton,
 ) -> SurfaceBuild:
     """``_extract_surface`` with its envelope under way."""
     geometry, settings, extra = key.geometry, key.settings, key.extra
     t0 = time.perf_counter()
     chosen, why = choose_backend(rig, backend, progress, tier)
     rest_field = BodyField(rig.graph, rig.slots)
-    skeleton = build_skeleton(spec, rig)
     validated = validated_mesh(rig, skeleton, tier, chosen, why, progress)
     ex, gates, policy, grid = validated.extraction, validated.gates, validated.policy, validated.grid
     mesh, refinement, sampling, timings = ex.mesh, validated.refinement, validated.sampling, validated.timings
@@ -1109,7 +1112,7 @@ def _extract_with(
     contract: SkinContract | None = None
     skin_tol = TIERS[tier].skin
     if skin_tol is None:
-        found = tier_candidates(spec, rig, tier)
+        found = tier_candidates(spec, rig, tier, envelope)
         programs, candidate_note = candidate_index(found, mesh.vertices)
     else:
         found = candidate_note = skin_note(tier)
