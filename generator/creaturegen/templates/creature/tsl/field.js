@@ -12,11 +12,11 @@ import {
 
 export const OP = Object.freeze({ LEAF: 0, POLY: 1, COPY: 2, LSE: 3, MIN: 4 });
 
-// Three explicit products summed left to right, as primitives._dot writes them.
+// Three explicit products summed left to right, as the reference sampler (field/primitives.py) writes its dot products.
 const dot3 = (u, v) => u.x.mul(v.x).add(u.y.mul(v.y)).add(u.z.mul(v.z));
 
-// primitives._perpendicular: the coordinate axis least aligned with `axis` (lowest index on ties),
-// its axial part removed, normalised.
+// The reference's helper axis (field/primitives.py): the coordinate axis least aligned with `axis`
+// (lowest index on ties), its axial part removed, normalised.
 function perpendicular(axis) {
   const ax = abs(axis.x), ay = abs(axis.y), az = abs(axis.z);
   const useX = ax.lessThanEqual(ay).and(ax.lessThanEqual(az));
@@ -38,7 +38,8 @@ export function rootSize({ slotCount, rows }, pose, base) {
 
 export function createField({ pose, programs, rows, slotCount, registers, gradientFloor, tiny }) {
   if (!Number.isInteger(slotCount) || slotCount < 1) throw new Error(`createField: slotCount must be a positive integer (got ${slotCount})`);
-  // primitives._Frame and both distance forms, with their gradients. Returns vec4(d, ∇d).
+  // The reference's segment frame and both distance forms (field/primitives.py primitive_field), with
+  // their gradients. Returns vec4(d, ∇d).
   const slotField = (p, base, slot) => {
     const o = base.add(slot.mul(rows));
     const rowA = pose.element(o).toVar();
@@ -58,7 +59,7 @@ export function createField({ pose, programs, rows, slotCount, registers, gradie
     const perp = perpendicular(axis).toVar();
     const result = vec4(0).toVar();
     If(roundCone.greaterThan(0.5), () => {
-      // primitives._round_cone_distance / round_cone_field.
+      // The round-cone form of primitive_field (field/primitives.py).
       const dr = ra.sub(rb);
       const nested = abs(dr).greaterThanEqual(len).or(degenerate);
       const sn = select(nested, float(0), dr.div(safeLen)).toVar();
@@ -79,7 +80,7 @@ export function createField({ pose, programs, rows, slotCount, registers, gradie
       const gSide = qHat.mul(c).add(axis.mul(sn));
       result.assign(vec4(d, select(capA, gA, select(capB, gB, gSide))));
     }).Else(() => {
-      // primitives._tapered_distance / tapered_capsule_field.
+      // The tapered-capsule form of primitive_field (field/primitives.py).
       const t = clamp(tRaw, 0, 1);
       const q = pa.sub(ba.mul(t)).toVar();
       const x = sqrt(dot3(q, q)).toVar();

@@ -32,7 +32,7 @@ export function createSkin({ pose, rows, field, correction }) {
   const quat = (base, s) => pose.element(base.add(s.mul(rows)).add(3));
   const shift = (base, s) => pose.element(base.add(s.mul(rows)).add(4)).xyz;
 
-  // deform._lbs: v + Σ wᵢ((Rᵢ − I)v + tᵢ), which returns the rest vertex bit for bit at rest.
+  // LBS, as the reference's skin_lbs (surface/deform.py): v + Σ wᵢ((Rᵢ − I)v + tᵢ), which returns the rest vertex bit for bit at rest.
   const lbs = (v, base, slots, weights) => {
     const acc = vec3(0).toVar();
     for (let c = 0; c < 4; c++) {
@@ -63,7 +63,7 @@ export function createSkin({ pose, rows, field, correction }) {
     return { real, dual };
   };
 
-  // deform._dq: normalised blended dual quaternion (real part br, dual part bd).
+  // DQ, as the reference's skin_dq: normalised blended dual quaternion (real part br, dual part bd).
   const dqBlend = (base, slots, weights) => {
     const { real, dual } = blendQuats(base, slots, weights, true);
     const norm = sqrt(dot4(real, real));
@@ -76,7 +76,7 @@ export function createSkin({ pose, rows, field, correction }) {
   };
   const dq = (v, base, slots, weights) => dqApply(dqBlend(base, slots, weights), v);
 
-  // deform._cor: v' = R(v − p*) + LBS(p*), R the normalised blend of the hemisphere-aligned rotations.
+  // CoR, as the reference's skin_cor: v' = R(v − p*) + LBS(p*), R the normalised blend of the hemisphere-aligned rotations.
   const corRotation = (base, slots, weights) => {
     const { real } = blendQuats(base, slots, weights, false);
     return real.div(sqrt(dot4(real, real))).toVar();

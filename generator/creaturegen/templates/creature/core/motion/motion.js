@@ -460,7 +460,7 @@ export function createMotion(data, lcg, { support = createFlatGround(), gravity 
     countPlanted(swinging);
   }
 
-  // A hopper's two hind legs, together (motion/simulate.py _hop_legs): planted while the body is on the
+  // A hopper's two hind legs, together (motion/simulate.py, Motion: the hopper's legs): planted while the body is on the
   // support (idle, crouch, landing); from the first air tick each foot leaves its take-off plant
   // (swingFrom), is drawn up toward its hip (leg.tuck) at the apex and reaches for its landing plant
   // (swingTo: the rest foot under the root at the landing tick). The target blends the two (smoothstep)
@@ -547,7 +547,7 @@ export function createMotion(data, lcg, { support = createFlatGround(), gravity 
     out[o] += trans[3 * p]; out[o + 1] += trans[3 * p + 1]; out[o + 2] += trans[3 * p + 2];
   }
 
-  // The bend limit (motion/simulate.py _bend): node j's neighbours at least bendMin apart; the anchor and
+  // The bend limit (motion/simulate.py, Motion: the rope bend limit): node j's neighbours at least bendMin apart; the anchor and
   // the point before it on the body are fixed, so the first two constraints move only the far node.
   function bend(cur, count, rope) {
     const bendMin = rope.bendMin;
@@ -571,7 +571,7 @@ export function createMotion(data, lcg, { support = createFlatGround(), gravity 
     }
   }
 
-  // Follow the leader from the anchor (motion/simulate.py _follow): each segment its rest length and
+  // Follow the leader from the anchor (motion/simulate.py, Motion: follow the leader): each segment its rest length and
   // within the bend limit of the one before (the first of the body's direction into the anchor), and
   // above the support, lifted by swinging the segment about its first node so its length holds.
   function follow(cur, count, rope) {
