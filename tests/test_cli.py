@@ -168,7 +168,7 @@ def test_posed_skin_faults_are_reported_by_default_and_refused_on_request(tmp_pa
     refused = tmp_path / "refused"
     done = run_cli("build", str(spec), "-o", str(refused), "--picture", "off", "--posed-gates", "refuse")
     assert done.returncode == 3, done.stderr[-2000:]
-    assert f"{spec}: surface.hero.posed: gate posed.folds" in done.stderr
+    assert f"{spec}: surface.hero: surface hero posed skin: gate posed.folds" in done.stderr
     assert "part.counter-tail" in done.stderr
     assert "worst in the envelope pose '" in done.stderr
     assert "Traceback" not in done.stderr

@@ -39,15 +39,9 @@ class Chain:
         self, indices: npt.NDArray[np.int32] | None = None, weights: F64 | None = None
     ) -> posed.Skinner:
         """LBS at every joint, with the chain's own weights or planted ones."""
-
-        @dataclass(frozen=True)
-        class Lbs:
-            methods: tuple[deform.Method, ...]
-            centers: F64
-
         pair = (self.indices if indices is None else indices, self.weights if weights is None else weights)
-        choice = Lbs(("lbs", "lbs"), np.zeros_like(self.mesh.vertices))
-        return posed.choice_skinner(self.mesh, self.normals, pair, self.skeleton, choice)  # type: ignore[arg-type]
+        choice = deform.DeformationChoice((), ("lbs", "lbs"), np.zeros_like(self.mesh.vertices), "", 0, 0.0)
+        return posed.choice_skinner(self.mesh, self.normals, pair, self.skeleton, choice)
 
     def quality(self, skin: posed.Skinner, pose: Pose, label: str) -> posed.PosedQuality:
         none = np.zeros(self.mesh.vertex_count)

@@ -42,8 +42,8 @@ from .surface.build import (
     SurfaceBuild,
     SurfaceRejectedError,
     build_surface,
-    posed_failures,
-    posed_refusal,
+    posed_gate_rows,
+    refuse_posed,
 )
 from .surface.deform import DeformationError
 from .surface.grid import GridTooFineError
@@ -197,15 +197,18 @@ def _identity(args: argparse.Namespace, name: str, spec: CharacterSpec, data: by
     if isinstance(build, int):
         return build
     _print_gates(build)
-    failed = posed_failures(build.sidecar)
-    if failed and args.posed_gates == "refuse":
-        print_errors(name, [SpecError(f"surface.{args.tier}.posed", posed_refusal(failed))])
-        return EXIT_REFUSED
-    for gate in failed:
-        print(
-            f"  warning: posed skin: {gate.name} = {gate.value:g} {gate.unit} ({gate.detail}); recorded in "
-            "assets/surface.json, not enforced (--posed-gates refuse refuses the build)"
-        )
+    if args.posed_gates == "refuse":
+        try:
+            refuse_posed(build.sidecar, args.tier)
+        except SurfaceRejectedError as exc:
+            print_errors(name, [SpecError(f"surface.{args.tier}", str(exc))])
+            return EXIT_REFUSED
+    for row in posed_gate_rows(build.sidecar):
+        if not row.get("passed"):
+            print(
+                f"  warning: posed skin: {row['name']} = {row['value']:g} {row['unit']} ({row['detail']}); "
+                "recorded in assets/surface.json, not enforced (--posed-gates refuse refuses the build)"
+            )
     counts = build.sidecar["counts"]
     print(f"  mesh {counts}; " + ("cache hit" if build.cached else "extracted"))
     return _Identity(name, spec, data, rig, build)

@@ -20,7 +20,7 @@ PACKAGE_ROOT = Path(__file__).resolve().parent
 PACKAGE = "creaturegen"
 
 
-def _path_of(module: str, root: Path) -> Path | None:
+def module_path(module: str, root: Path = PACKAGE_ROOT) -> Path | None:
     """The file of a creaturegen module (a package's ``__init__.py``), or None outside the package."""
     parts = module.split(".")
     if parts[0] != PACKAGE:
@@ -32,7 +32,7 @@ def _path_of(module: str, root: Path) -> Path | None:
     return file if file.is_file() else None
 
 
-def _imported(tree: ast.AST, module: str, is_package: bool) -> set[str]:
+def imported_modules(tree: ast.AST, module: str, is_package: bool) -> set[str]:
     """Dotted names of what ``module``'s text imports: modules, and for ``from X import y`` both X and
     X.y (y may be a submodule or an attribute; the caller keeps what is a file)."""
     out: set[str] = set()
@@ -75,12 +75,12 @@ def code_closure(entry: str, root: Path = PACKAGE_ROOT) -> dict[str, str]:
         module = todo.pop()
         if module in seen:
             continue
-        path = _path_of(module, root)
+        path = module_path(module, root)
         if path is None:
             continue
         tree = ast.parse(path.read_text(encoding="utf-8"), filename=str(path))
         seen[module] = _without_prose(tree)
-        todo.extend(_imported(tree, module, path.name == "__init__.py") - set(seen))
+        todo.extend(imported_modules(tree, module, path.name == "__init__.py") - set(seen))
     return seen
 
 

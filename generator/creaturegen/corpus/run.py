@@ -148,8 +148,10 @@ def run_job(job: Job, packages: Path, timeout: float = BUILD_TIMEOUT_S, workers:
         mesh = re.search(r"mesh \{'vertices': (\d+), 'triangles': (\d+)", stdout)
         if mesh:
             record["vertices"], record["triangles"] = int(mesh.group(1)), int(mesh.group(2))
-        # Posed-skin gates are reported, not enforced (surface/posed.py): the build prints each failure.
-        record["posedFailed"] = re.findall(r"warning: posed skin: (posed\.\w+) =", stdout)
+        # Posed-skin gates are recorded, not enforced (surface/posed.py): read from the build report.
+        report = Path(record["package"]) / "build-report.json"
+        rows = json.loads(report.read_text())["surface"]["posedGates"] if report.is_file() else []
+        record["posedFailed"] = [r["name"] for r in rows if not r["passed"]]
     else:
         record.update(parse_refusal(stderr))
         if status == "error":

@@ -12,7 +12,7 @@ from ..emit.writer import PackageFile, header_text, write_package
 from ..rig import CompiledRig
 from ..spec import CharacterSpec, slugify
 from ..surface.asset import glb_bytes, sidecar_bytes
-from ..surface.build import SurfaceBuild
+from ..surface.build import SurfaceBuild, posed_gate_rows
 from ..surface.emit import stable_sidecar
 from .assets import PICTURE_PATH, REPORT_PATH, SIDECAR_PATH, SPEC_PATH, shipped_files, shipped_spec
 from .plan import build_plan
@@ -36,18 +36,12 @@ def build_report(plan: dict[str, Any], surface: SurfaceBuild) -> dict[str, Any]:
             "passed": surface.passed,
             "counts": surface.sidecar.get("counts"),
             # Recorded, not enforced (surface/posed.py; `creaturegen build --posed-gates refuse`).
-            "posedGates": _posed_rows(surface.sidecar),
+            "posedGates": posed_gate_rows(surface.sidecar),
         },
         # Where the package's files are: Python tools read the asset path here (creature/assets.py).
         "assets": {"surface": plan["assets"]["surfacePath"], "spec": SPEC_PATH, "sidecar": SIDECAR_PATH},
         "gates": plan["gates"],
     }
-
-
-def _posed_rows(sidecar: dict[str, Any]) -> list[Any]:
-    posed = sidecar.get("posed")
-    rows = posed.get("gates", []) if isinstance(posed, dict) else []
-    return list(rows) if isinstance(rows, list) else []
 
 
 def creature_files(

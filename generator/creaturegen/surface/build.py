@@ -413,22 +413,18 @@ def runtime_skin(
     return np.stack([method, radius], axis=1).astype(np.float32)
 
 
-def posed_failures(sidecar: dict[str, object]) -> list[SurfaceGate]:
-    """The posed-skin gates (surface/posed.py) a build failed, read back from its sidecar (cache hits
-    included). They are recorded, not enforced: the caller decides (``creaturegen build --posed-gates``)."""
+def posed_gate_rows(sidecar: dict[str, object]) -> list[dict[str, object]]:
+    """The posed-skin gates (surface/posed.py) as the sidecar records them (cache hits included)."""
     posed = sidecar.get("posed")
     rows = posed.get("gates", []) if isinstance(posed, dict) else []
-    gates = [_gate_from_row(g) for g in rows if isinstance(g, dict)]
-    return [g for g in gates if not g.passed]
+    return [r for r in rows if isinstance(r, dict)] if isinstance(rows, list) else []
 
 
-def posed_refusal(failed: list[SurfaceGate]) -> str:
-    """A refusal naming the first failed posed gate (its detail names the parts and the pose)."""
-    g = failed[0]
-    more = f" (also failed: {', '.join(f.name for f in failed[1:])})" if len(failed) > 1 else ""
-    return (
-        f"gate {g.name} = {g.value:.4g} {g.unit}, threshold {g.threshold:.4g} ({g.direction}): "
-        f"{g.detail}{more}{POSED_REMEDY}"
+def refuse_posed(sidecar: dict[str, object], tier: str) -> None:
+    """Raise SurfaceRejectedError when a posed-skin gate failed. The gates are recorded, not enforced by
+    the build: the caller asks for this (``creaturegen build --posed-gates refuse``)."""
+    _fail_on(
+        [_gate_from_row(r) for r in posed_gate_rows(sidecar)], f"surface {tier} posed skin", POSED_REMEDY
     )
 
 

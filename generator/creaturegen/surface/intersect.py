@@ -186,12 +186,14 @@ def overlapping_leaf_pairs(bvh: BVH, groups: I64 | None = None) -> tuple[I64, I6
     a = np.zeros(1, dtype=np.int64)
     b = np.zeros(1, dtype=np.int64)
     lo, hi = np.ascontiguousarray(bvh.lo.T).T, np.ascontiguousarray(bvh.hi.T).T
-    for d in range(bvh.depth):
+    for d in range(bvh.depth + 1):
         if groups is not None:
             here = (1 << d) - 1
             ga, gb = groups[a + here], groups[b + here]
             wanted = (ga < 0) | (ga != gb)
             a, b = a[wanted], b[wanted]
+        if d == bvh.depth:
+            break
         same = a == b
         sa, da, db = a[same], a[~same], b[~same]
         na = np.concatenate([2 * sa, 2 * sa, 2 * sa + 1, 2 * da, 2 * da, 2 * da + 1, 2 * da + 1])
@@ -208,12 +210,7 @@ def candidate_pairs(
     """Batches of face pairs (i, j), each unordered pair once, whose AABBs overlap and that share no
     vertex index. With ``groups`` (F,), pairs of faces in one group ≥ 0 are left out, whole leaf pairs
     first: faces a pose moved together (surface/posed.py)."""
-    tree_groups = None if groups is None else node_groups(bvh, groups)
-    la, lb = overlapping_leaf_pairs(bvh, tree_groups)
-    if tree_groups is not None:
-        one = tree_groups[(1 << bvh.depth) - 1 :]
-        keep = (one[la] < 0) | (one[la] != one[lb])
-        la, lb = la[keep], lb[keep]
+    la, lb = overlapping_leaf_pairs(bvh, None if groups is None else node_groups(bvh, groups))
     m = bvh.leaves.shape[1]
     f = np.asarray(faces, dtype=np.int64)
     lo, hi = np.ascontiguousarray(bvh.prim_lo.T).T, np.ascontiguousarray(bvh.prim_hi.T).T

@@ -35,7 +35,6 @@ body does not have (skin outside the body, or sunk into a part) and is gated, as
 
 from __future__ import annotations
 
-import time
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from typing import Final
@@ -94,7 +93,6 @@ class PoseQuality:
 class PosedQuality:
     poses: tuple[PoseQuality, ...]
     faces: int
-    seconds: float
 
     def worst(self, key: str) -> PoseQuality | None:
         return max(self.poses, key=lambda p: getattr(p, key), default=None)
@@ -369,7 +367,6 @@ def posed_quality(
 ) -> PosedQuality:
     """Every envelope pose measured (see the module docstring); ``radius`` is the runtime's correction
     trust radius per vertex (zero outside the correction region)."""
-    t = time.perf_counter()
     edges = deform.edge_faces(mesh.faces.astype(np.int64))
     rest_n = unit_rows(mesh.face_normals())
     rest_turn = angles_deg(rest_n[edges[:, 0]], rest_n[edges[:, 1]])
@@ -378,7 +375,7 @@ def posed_quality(
         pose_quality(rig, mesh, weights, skin, radius, pose, label, edges, rest_turn, tree)
         for pose, label in zip(poses, labels, strict=True)
     )
-    return PosedQuality(measured, mesh.face_count, time.perf_counter() - t)
+    return PosedQuality(measured, mesh.face_count)
 
 
 def posed_gates(quality: PosedQuality, face_parts: Sequence[str]) -> list[SurfaceGate]:
