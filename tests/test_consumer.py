@@ -368,9 +368,10 @@ def test_planted_swapped_asset_fails(consumer: Consumer, reference: dict[str, An
 
 
 def test_planted_untyped_export_fails(consumer: Consumer) -> None:
-    """Removing one export's declaration from a package's index.d.ts makes the strict type-check fail."""
+    """Removing one export's declaration from a package's diagnostics entry types makes the strict
+    type-check fail (the entry is resolved through package.json "exports")."""
     slug = next(iter(CREATURES))
-    dts = consumer.root / "node_modules" / slug / "index.d.ts"
+    dts = consumer.root / "node_modules" / slug / "tsl" / "diagnostics.d.ts"
     original = dts.read_text()
     planted = original.replace("export function createDiagnostics", "declare function createDiagnostics")
     assert planted != original

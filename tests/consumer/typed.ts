@@ -7,9 +7,9 @@ import {
   DEBUG_MODES,
   createAnalyticWater,
   createCreaturePopulation,
-  createDiagnostics,
   createMotion,
 } from 'hopper-squash-core';
+import { createDiagnostics } from 'hopper-squash-core/diagnostics';
 import { createCreaturePopulation as createQuadrupeds } from 'quadruped-rope-tail';
 import { createFrostEffect } from 'frost-pane-balanced';
 
@@ -22,10 +22,11 @@ export async function typed(renderer: THREE.WebGPURenderer, scene: THREE.Scene, 
   hoppers.setDebugMode(DEBUG_MODES[0]);
   const diagnostics = createDiagnostics(renderer, hoppers);
   const pose: Float32Array = await diagnostics.readPose(id);
+  const staged: Float32Array = diagnostics.stagedPose(id);
   const slug: string = CREATURE.slug;
   const motion = createMotion(CREATURE.motion, CREATURE.lcg, { seed: 1 });
   const frost = await createFrostEffect(renderer, scene, camera);
   frost.update(0, 1 / 60);
   frost.render();
-  return steps + pose.length + slug.length + (motion ? 1 : 0);
+  return steps + pose.length + staged.length + slug.length + (motion ? 1 : 0);
 }

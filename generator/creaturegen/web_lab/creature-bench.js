@@ -57,6 +57,7 @@ async function main() {
   const device = renderer.backend.device;
   const pkg = await import(`/out/${slug}/index.js`);
   const tsl = await import(`/out/${slug}/tsl/index.js`);
+  const { populationInternals } = await import(`/out/${slug}/tsl/diagnostics.js`);
   const data = pkg.CREATURE;
   const L = data.bodyScale;
   draws.bodyIndexCount = 3 * data.mesh.triangles;
@@ -88,14 +89,15 @@ async function main() {
   // Water for every package (only a swimmer reads it); bodies walk on the default flat ground.
   const pop = await tsl.createCreaturePopulation(renderer, { capacity, pageSize, water: pkg.createAnalyticWater() });
   scene.add(pop.object3d);
-  const layout = pop.layout;
+  const internals = populationInternals(pop);
+  const { layout } = internals;
   const step = fdStep * L;
 
   // Both variants' deform pre-passes, one per page, built before anything is timed. The material, the
   // storage and the draws are the package's own in both: only the field path in the pre-pass differs.
   const kernels = {
     shipped: pop.pages.map((p) => p.kernel),
-    baseline: pop.pages.map((p) => createBaselineKernel(tsl, layout, p, pop.records, pop.programs, step)),
+    baseline: pop.pages.map((p) => createBaselineKernel(tsl, layout, p, internals.records, internals.programs, step)),
   };
   let variant = 'shipped';
   function setVariant(v) {
@@ -164,7 +166,7 @@ async function main() {
   let fieldState = null;
   function fieldKernels(copies) {
     if (fieldState && fieldState.copies === copies) return fieldState;
-    const g = pop.geometry.attributes;
+    const g = internals.geometry.attributes;
     const code = (v) => g.cgSkin.array[4 * v + 2];
     const isSkin = (c) => Math.abs(c - layout.skinProgram) < 0.5;
     const all = Array.from({ length: g.position.count }, (_, v) => v);
@@ -182,7 +184,7 @@ async function main() {
       pts[4 * i + 3] = c > layout.skinProgram - 0.5 ? layout.fullProgram : c;
     }
     const points = instancedArray(pts, 'vec4').toReadOnly();
-    const fns = baselineFunctions(tsl, layout, pop.pages[0].pose, pop.programs, step);
+    const fns = baselineFunctions(tsl, layout, pop.pages[0].pose, internals.programs, step);
     const kernel = (query) => {
       const result = instancedArray(n, 'vec4');
       const node = Fn(() => {

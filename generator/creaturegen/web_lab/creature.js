@@ -62,7 +62,8 @@ async function main() {
   // Water is passed to every package (only a swimmer reads it); the ground plane is the flat support y = 0.
   const pop = await pkg.createCreaturePopulation(renderer, { capacity, pageSize, water: pkg.createAnalyticWater() });
   scene.add(pop.object3d);
-  const diag = pkg.createDiagnostics(renderer, pop);
+  const { createDiagnostics } = await import(`/out/${slug}/tsl/diagnostics.js`);
+  const diag = createDiagnostics(renderer, pop);
   pop.spawn({ seed: Number(params.get('seed') ?? 1), position: [0, 0, 0] });
   pop.flush();
 
@@ -328,7 +329,7 @@ async function main() {
         tick: pop.tick, count: pop.count, debugMode: pop.debugMode, stats: { ...pop.stats },
         pagesInUse: pop.pages.filter((p) => p.mesh.count > 0).length, pages: pop.pages.length,
         instances: Array.from({ length: pop.count }, (_, i) => pop.instance(i)),
-        variantKeys: pop.variantKeys(), errors: errors.length,
+        variantKeys: diag.variantKeys(), errors: errors.length,
       };
     },
     setTier(t) { pop.setTier(t); return t; },
@@ -408,7 +409,7 @@ async function main() {
       if (markers.instanceColor) markers.instanceColor.needsUpdate = true;
       return out;
     },
-    stagedPose(i = 0) { return Array.from(pop.stagedPose(i)); },
+    stagedPose(i = 0) { return Array.from(diag.stagedPose(i)); },
     async readSkinned(i = 0) {
       const r = await diag.readSkinned(i);
       return { skinned: toBase64(new Uint8Array(r.skinned.buffer)), corrected: toBase64(new Uint8Array(r.corrected.buffer)),

@@ -88,22 +88,12 @@ export interface CreaturePopulation {
   /** Upload the dirty pose ranges left by spawn/despawn and run the deform pre-pass over them. */
   flush(): number;
   instance(id: number): InstanceInfo;
-  stagedPose(id: number): Float32Array;
   stateHash(): string;
   setDebugMode(mode: DebugMode): void;
   setTier(tier: TierName): void;
-  variantKeys(): string[];
   /** Build every shipped variant (deform compute, display, shadow) before the first visible frame. */
   warm(scene: Object3D, camera: Camera): Promise<void>;
   dispose(): void;
-}
-
-export interface CreatureDiagnostics {
-  readSkinned(id: number): Promise<{ skinned: Float32Array; corrected: Float32Array; accepted: Float32Array; gradient: Float32Array; distance: Float32Array }>;
-  probeField(id: number, xyz: Float32Array, program?: number): Promise<Float32Array>;
-  readPose(id: number): Promise<Float32Array>;
-  /** What the passes draw: the page's deform storage for instance `id` (creature-local). */
-  readDeformed(id: number): Promise<{ position: Float32Array; gradient: Float32Array; distance: Float32Array; accepted: Float32Array; colour: Float32Array; program: Float32Array }>;
 }
 
 export const DEBUG_MODES: readonly DebugMode[];
@@ -114,4 +104,3 @@ export function assertThreeRevision(revision?: string): void;
  * Rejects with SurfaceMismatchError when the fetched .glb is not this package's surface.
  */
 export function createCreaturePopulation(renderer: WebGPURenderer, options?: PopulationOptions): Promise<CreaturePopulation>;
-export function createDiagnostics(renderer: WebGPURenderer, population: CreaturePopulation, options?: { maxPoints?: number }): CreatureDiagnostics;

@@ -1,2 +1,2 @@
 export * from './core/index.js';
-export { DEBUG_MODES, assertThreeRevision, createCreaturePopulation, createDiagnostics } from './tsl/index.js';
+export { DEBUG_MODES, assertThreeRevision, createCreaturePopulation } from './tsl/index.js';

@@ -1,12 +1,20 @@
-// Diagnostics for the lab and the parity job: compute kernels that call the very same TSL functions as
-// the material (field programs, skinning, correction), with results read back from the GPU. Kernels and
-// their buffers are created on first use, never by spawn or render.
+// The package's diagnostics entry (`<package>/diagnostics`), for labs and parity jobs, not for an app's
+// frame loop: compute kernels that call the very same TSL functions as the material (field programs,
+// skinning, correction), with results read back from the GPU, and the CPU staging of a body's pose. Kernels
+// and their buffers are created on first use, never by spawn or render. An app that never imports this
+// entry ships none of it.
 import { Fn, instanceIndex, instancedArray, int, uniform, vec4 } from 'three/tsl';
 import { bodyFunctions, bodyVertex } from './body.js';
 import { DEFORM_STRIDE, recordInputs } from './deform.js';
+import { populationInternals } from './internals.js';
 
+export { populationInternals };
+
+/** Readbacks of `population` (created by this package's createCreaturePopulation) through its own kernels. */
 export function createDiagnostics(renderer, population, { maxPoints = 8192 } = {}) {
-  const { layout, programs, geometry, pages } = population;
+  const internals = populationInternals(population);
+  const { layout, programs, geometry, records } = internals;
+  const { pages } = population;
   const n = geometry.attributes.position.count;
   const rowsPerInstance = layout.maxParts * layout.rows;
   let skinState = null;
@@ -21,7 +29,7 @@ export function createDiagnostics(renderer, population, { maxPoints = 8192 } = {
       return Fn(() => {
         const i = int(instanceIndex);
         const base = instance.mul(rowsPerInstance).toVar();
-        const body = bodyVertex(layout, fns, { ...recordInputs(population.records, i), base, skinOnly: false });
+        const body = bodyVertex(layout, fns, { ...recordInputs(records, i), base, skinOnly: false });
         out.element(i.mul(3)).assign(vec4(body.skinned, 0));
         out.element(i.mul(3).add(1)).assign(vec4(body.position, body.accepted));
         out.element(i.mul(3).add(2)).assign(vec4(body.gradient, body.distance));
@@ -51,12 +59,16 @@ export function createDiagnostics(renderer, population, { maxPoints = 8192 } = {
   }
 
   return {
+    /** Pose rows of instance `id` from the CPU staging copy (what the next upload sends). */
+    stagedPose: internals.stagedPose,
+    /** The debug-mode variants built so far ('off' is the shipped one). */
+    variantKeys: internals.variantKeys,
     /**
      * Skinned, corrected and gradient data of instance `id` (creature-local, before the root
      * transform): { skinned, corrected, accepted, gradient, distance } as Float32Arrays.
      */
     async readSkinned(id) {
-      const { page, index } = population.locate(id);
+      const { page, index } = internals.locate(id);
       const s = skinKernels();
       s.instance.value = index;
       renderer.compute(s.kernels[pages.indexOf(page)]);
@@ -78,7 +90,7 @@ export function createDiagnostics(renderer, population, { maxPoints = 8192 } = {
     async probeField(id, xyz, program = layout.fullProgram) {
       const count = xyz.length / 3;
       if (count > maxPoints) throw new Error(`probeField: at most ${maxPoints} points per call (got ${count})`);
-      const { page, index } = population.locate(id);
+      const { page, index } = internals.locate(id);
       const s = probeKernels();
       const arr = s.points.value.array;
       arr.fill(0);
@@ -95,7 +107,7 @@ export function createDiagnostics(renderer, population, { maxPoints = 8192 } = {
      * the root transform): { position, gradient, distance, accepted, colour, program } as Float32Arrays.
      */
     async readDeformed(id) {
-      const { page, index } = population.locate(id);
+      const { page, index } = internals.locate(id);
       const floats = 4 * DEFORM_STRIDE * n;
       const raw = new Float32Array(await renderer.getArrayBufferAsync(page.deform.value, null, 4 * floats * index, 4 * floats));
       const position = new Float32Array(3 * n), gradient = new Float32Array(3 * n), colour = new Float32Array(3 * n);
@@ -115,7 +127,7 @@ export function createDiagnostics(renderer, population, { maxPoints = 8192 } = {
     },
     /** The pose rows of instance `id` as the GPU holds them (readback). */
     async readPose(id) {
-      const { page, index } = population.locate(id);
+      const { page, index } = internals.locate(id);
       const floats = rowsPerInstance * 4;
       const buffer = await renderer.getArrayBufferAsync(page.pose.value, null, 4 * floats * index, 4 * floats);
       return new Float32Array(buffer);

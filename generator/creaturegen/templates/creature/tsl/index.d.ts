@@ -6,9 +6,9 @@ import type {
 import type { CreatureData, DebugMode, ParsedSurface } from '../core/index.js';
 
 export type {
-  CreatureDiagnostics, CreaturePopulation, InstanceInfo, PopulationOptions, SpawnOptions,
+  CreaturePopulation, InstanceInfo, PopulationOptions, SpawnOptions,
 } from '../index.js';
-export { DEBUG_MODES, assertThreeRevision, createCreaturePopulation, createDiagnostics } from '../index.js';
+export { DEBUG_MODES, assertThreeRevision, createCreaturePopulation } from '../index.js';
 
 // --- the node builders the population is made of (used by the creaturegen lab; stable within a release) ---
 

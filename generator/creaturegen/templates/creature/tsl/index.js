@@ -1,5 +1,5 @@
 // Three/TSL adapter: pose pages, field programs, skinning, the deform pre-pass, materials, population,
-// the diagnostic shell, diagnostics.
+// the diagnostic shell (the readback diagnostics are their own entry, `<package>/diagnostics`).
 export { OP, createField, rootSize } from './field.js';
 export { METHOD, createSkin, rotate } from './skin.js';
 export { bodyFunctions, bodyVertex, layoutOf } from './body.js';
@@ -12,4 +12,3 @@ export {
   assertThreeRevision, assertWebGPU, createCreaturePopulation, programStorage, surfaceGeometry,
 } from './population.js';
 export { SURFACE_FILE, defaultSurfaceUrl } from './asset.js';
-export { createDiagnostics } from './diagnostics.js';

@@ -20,6 +20,7 @@ import {
   DEFORM_STRIDE, createDeformKernel, deformStorage, deformView, dispatchDeform, vertexRecords,
 } from './deform.js';
 import { checkDebugMode, createBodyMaterial } from './material.js';
+import { registerInternals } from './internals.js';
 import { createShellMesh } from './shell.js';
 
 const SHIPPED_VARIANTS = ['off'];
@@ -264,11 +265,7 @@ export async function createCreaturePopulation(renderer, options = {}) {
 
   const population = {
     object3d: group,
-    data,
     pages,
-    layout,
-    programs,
-    geometry,
     get tick() { return tick; },
     get debugMode() { return mode; },
     get capacity() { return capacity; },
@@ -365,11 +362,6 @@ export async function createCreaturePopulation(renderer, options = {}) {
     driver,
     /** Upload whatever spawn/despawn left dirty (called by the owner before rendering). */
     flush,
-    /** Internal: the page holding instance `id` and its index there. */
-    locate(id) {
-      const { page, j } = locate(id);
-      return { page, index: j };
-    },
     instance(id) {
       const { page, j } = locate(id);
       const m = page.motions[j];
@@ -381,11 +373,6 @@ export async function createCreaturePopulation(renderer, options = {}) {
     motion(id) {
       const { page, j } = locate(id);
       return page.motions[j];
-    },
-    /** Pose rows of one instance from the CPU staging copy (what the next upload sends). */
-    stagedPose(id) {
-      const { page, j } = locate(id);
-      return page.staging.slice(j * floatsPerInstance, (j + 1) * floatsPerInstance);
     },
     stateHash() {
       return hashBytes(pages.map((p) => new Uint8Array(p.staging.buffer, p.staging.byteOffset, p.staging.byteLength)), tick);
@@ -403,9 +390,6 @@ export async function createCreaturePopulation(renderer, options = {}) {
     setTier(t) {
       if (t !== data.tier) throw new Error(`tier: this package was built for tier ${data.tier} (got ${t}); rebuild with --tier ${t}`);
     },
-    variantKeys() { return [...variants.keys()]; },
-    /** The rest-vertex records (deform.js) every page's pre-pass reads. */
-    records,
     /**
      * Build every shipped variant's pipelines (deform compute, display and shadow) and every page's deform
      * storage before the first visible frame.
@@ -429,5 +413,21 @@ export async function createCreaturePopulation(renderer, options = {}) {
       group.removeFromParent();
     },
   };
-  return population;
+  return registerInternals(population, {
+    data, layout, programs, geometry,
+    /** The rest-vertex records (deform.js) every page's pre-pass reads. */
+    records,
+    /** The page holding instance `id` and its index there. */
+    locate(id) {
+      const { page, j } = locate(id);
+      return { page, index: j };
+    },
+    /** Pose rows of one instance from the CPU staging copy (what the next upload sends). */
+    stagedPose(id) {
+      const { page, j } = locate(id);
+      return page.staging.slice(j * floatsPerInstance, (j + 1) * floatsPerInstance);
+    },
+    /** The debug-mode variants built so far ('off' is the shipped one). */
+    variantKeys() { return [...variants.keys()]; },
+  });
 }
