@@ -17,7 +17,7 @@ this run:
   backend that was faster at band sampling in this run, the baseline the headline saving uses. Dense
   signs are checked against the band's sign lattice away from zero (``|d| ≥ δ``, the settle band);
 * **extraction** (``surface/extract.py: extract`` on the numpy band) and **validation**
-  (``surface/build.py: surface_mesh_gates``: the build's gates and thresholds and the component policy,
+  (``surface/mesh_gates.py: surface_mesh_gates``: the build's gates and thresholds and the component policy,
   at the first lattice only: the build's √2 refinement on a failed gate is not benchmarked),
   each timed once: vertex and triangle counts, every gate as measured, the names of failed gates.
 
@@ -52,12 +52,12 @@ from creaturegen.model.skeleton import Skeleton, build_skeleton
 from creaturegen.rig import CompiledRig, compile_rig
 from creaturegen.spec import CharacterSpec, load_spec
 from creaturegen.surface.backends import BackendUnavailableError, FieldBackend, NumpyBackend, make_backend
-from creaturegen.surface.build import surface_mesh_gates
 from creaturegen.surface.components import ComponentPolicy
 from creaturegen.surface.extract import extract
 from creaturegen.surface.field64 import BodyField
 from creaturegen.surface.gates import SurfaceGate
 from creaturegen.surface.grid import ERROR_TARGET, Grid, GridTooFineError, make_grid, smallest_radius
+from creaturegen.surface.mesh_gates import surface_mesh_gates
 from creaturegen.surface.sampling import SIGN_SETTLE_FACTOR, NarrowBand, sample_band
 
 T = TypeVar("T")
@@ -489,7 +489,7 @@ def main(argv: Sequence[str] | None = None) -> int:
             "numpy_dense_max_nodes": NUMPY_DENSE_MAX_NODES,
             "dense_backend": "per tier, the backend with the faster narrow-band sampling in this run",
             "extraction_and_validation": "timed once each, on the numpy band",
-            "validation": "surface/build.py surface_mesh_gates: the build's mesh gates and thresholds "
+            "validation": "surface/mesh_gates.py surface_mesh_gates: the build's mesh gates and thresholds "
             "and its component policy, on the first lattice (no refinement)",
             "ratios": "dense_over_band: dense pass / band sampling per backend; numpy_over_wgpu: the same "
             "variant on both backends; all from best times of this run",

@@ -20,8 +20,8 @@ import pytest
 
 from creaturegen.rig import CompiledRig, compile_rig
 from creaturegen.spec import CharacterSpec, load_spec
-from creaturegen.surface.asset import exclusive
 from creaturegen.surface.backends import NumpyBackend
+from creaturegen.surface.cache import exclusive
 from creaturegen.surface.extract import Extraction, extract
 from creaturegen.surface.field64 import BodyField
 from creaturegen.surface.grid import Grid, make_grid

@@ -10,10 +10,12 @@ import numpy as np
 import pytest
 
 from conftest import EXAMPLES, REPO, run_cli
-from creaturegen import __version__, cli
+from creaturegen import __version__, cli, cli_build
+from creaturegen.cli_errors import EXIT_GATE_FAILED, EXIT_INVALID, EXIT_OK, EXIT_REFUSED
 from creaturegen.field.sampler import sample
 from creaturegen.rig import compile_rig
 from creaturegen.spec import CharacterSpec, load_spec
+from creaturegen.surface.build import SurfaceBuild
 
 
 def test_version() -> None:
@@ -187,19 +189,19 @@ def test_population_short_of_n_identities_exits_3(
 
     def identity(
         args: object, name: str, one: CharacterSpec, data: bytes
-    ) -> cli._Identity | int:  # the authored identity passes, every variant is refused
+    ) -> cli_build._Identity | int:  # the authored identity passes, every variant is refused
         if name != str(source):
-            return cli.EXIT_REFUSED
-        return cli._Identity(name, one, data, compile_rig(one), cast(cli.SurfaceBuild, None))
+            return EXIT_REFUSED
+        return cli_build._Identity(name, one, data, compile_rig(one), cast(SurfaceBuild, None))
 
-    monkeypatch.setattr(cli, "_identity", identity)
+    monkeypatch.setattr(cli_build, "_identity", identity)
     out = tmp_path / "out"
     code = cli.main(["build", str(source), "-o", str(out), "--population", "2", "--picture", "off"])
-    assert code == cli.EXIT_REFUSED == 3
+    assert code == EXIT_REFUSED == 3
     assert "only 1 of 2 identities passed every gate in 8 draws" in capsys.readouterr().err
     assert not out.exists()
 
 
 def test_exit_codes_are_distinct() -> None:
-    codes = (cli.EXIT_OK, cli.EXIT_GATE_FAILED, cli.EXIT_INVALID, cli.EXIT_REFUSED)
+    codes = (EXIT_OK, EXIT_GATE_FAILED, EXIT_INVALID, EXIT_REFUSED)
     assert codes == (0, 1, 2, 3)

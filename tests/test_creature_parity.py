@@ -6,7 +6,7 @@ when the browser or node_modules is missing.
 
 Every gate runs on every example, the spawn burst's frame included. The deform pre-pass runs each body's
 vertex path once per tick in software, so that frame's cost grows with the bodies in it (hence a burst
-of one page plus one body, creature_parity.PAGE_SIZE).
+of one page plus one body, creature_population.PAGE_SIZE).
 """
 
 from __future__ import annotations
@@ -18,7 +18,8 @@ from pathlib import Path
 import pytest
 
 from conftest import CREATURE_EXAMPLES, build_example
-from creaturegen.lab.creature_parity import GATE_GROUPS, PAGE_SIZE, SPAWNS, run_creature_parity
+from creaturegen.lab.creature_parity import GATE_GROUPS, run_creature_parity
+from creaturegen.lab.creature_population import PAGE_SIZE, SPAWNS
 
 
 @pytest.fixture

@@ -27,7 +27,8 @@ from creaturegen.frost.schedule import bin_steps
 from creaturegen.frost.structure import generate_structure
 from creaturegen.frost.timeline import chunk_steps, late_steps, split_interval
 from creaturegen.lab.browser import launch_lab_page
-from creaturegen.lab.frost_parity import shipped_structure, strokes_at_once
+from creaturegen.lab.frost_history import strokes_at_once
+from creaturegen.lab.frost_texels import shipped_structure
 from creaturegen.lab.server import WEB_LAB, serve
 from creaturegen.resources import lab_modules
 from creaturegen.spec.frost import Structure

@@ -1,5 +1,5 @@
 """A hopper on two hind legs (issue 22): the spec takes 0 or 2 leg parts, and the legs plant, fold, push off,
-tuck and land with the hop (motion/simulate.py _hop_legs; the JS core's parity and the motion gates run on
+tuck and land with the hop (motion/hop.py hop_legs; the JS core's parity and the motion gates run on
 tests/fixtures/kangaroo.json through conftest.MOTION_FIXTURES)."""
 
 from __future__ import annotations
@@ -13,8 +13,11 @@ import pytest
 
 from creaturegen.model.skeleton import build_skeleton
 from creaturegen.motion import quat as vq
+from creaturegen.motion.gait import home
+from creaturegen.motion.hop import hop_at
 from creaturegen.motion.providers import builtin_supports, to_local, to_world
 from creaturegen.motion.rig import build_motion
+from creaturegen.motion.root import to_local_root, to_world_root
 from creaturegen.motion.simulate import Motion
 from creaturegen.rig import compile_rig
 from creaturegen.spec import CharacterSpec, SpecValidationError, load_spec, validate_bytes
@@ -124,11 +127,11 @@ def test_the_kangaroos_feet_stay_planted_on_the_ground_and_leave_it_in_the_air(s
         for leg, foot in zip(motion.data["legs"], motion.feet, strict=True):
             hip, knee, drawn = _drawn(motion, leg)
             span = leg["a"] + leg["b"]
-            at = to_local(frame, motion.to_world_root(motion.root, drawn))
+            at = to_local(frame, to_world_root(motion.root, drawn))
             knees.setdefault(phase, []).append(_knee_deg(hip, knee, drawn))
             if phase != "air":
                 assert foot.planted, f"{support} tick {n} ({phase}): foot of {leg['part']} lifted"
-                target = motion.to_local_root(motion.root, to_world(frame, foot.p))
+                target = to_local_root(motion.root, to_world(frame, foot.p))
                 reach = vq.distance(target, leg["hip"])
                 assert leg["reachMin"] < reach < leg["reachMax"], f"{support} tick {n}: IK clamped"
                 drift = max(drift, vq.distance(at, foot.p) / span)
@@ -176,7 +179,7 @@ def test_the_landing_plant_is_where_the_hop_lands(support: str) -> None:
             for leg, foot, where, was in zip(motion.data["legs"], motion.feet, aimed, start, strict=True):
                 assert foot.planted
                 assert foot.p == where
-                assert foot.p == motion._home(leg, frame, motion.root)
+                assert foot.p == home(leg, frame, motion.root)
                 assert 0.9 < math.dist(was, where) / motion.data["hopLength"] < 1.1
             hops += 1
 
@@ -189,7 +192,7 @@ def test_a_hopper_without_legs_does_not_sink() -> None:
     motion = Motion(build_motion(spec, rig, build_skeleton(spec, rig)))
     assert motion.d.dip == 0.0
     for n in range(motion.d.hop_cycle):
-        _, lift, _ = motion._hop(n)
+        _, lift, _ = hop_at(motion.data, motion.d, n)
         if _phase(motion, n) != "air":
             assert lift == 0.0
             assert math.copysign(1.0, lift) == 1.0

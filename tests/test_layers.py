@@ -24,7 +24,7 @@ LAYERS: tuple[frozenset[str], ...] = (
     frozenset({"creature", "frost"}),
     frozenset({"lab"}),
     frozenset({"corpus"}),
-    frozenset({"cli", "__main__"}),
+    frozenset({"cli", "cli_args", "cli_build", "cli_commands", "cli_errors", "cli_report", "__main__"}),
 )
 LEVEL = {name: i for i, layer in enumerate(LAYERS) for name in layer}
 

@@ -37,7 +37,9 @@ from creaturegen.motion.providers import (
     to_world,
 )
 from creaturegen.motion.rig import WALKERS, build_motion
-from creaturegen.motion.simulate import Gates, Motion, TierRefusedError
+from creaturegen.motion.root import to_local_root
+from creaturegen.motion.simulate import Motion, TierRefusedError
+from creaturegen.motion.state import Gates
 from creaturegen.rig import compile_rig
 from creaturegen.spec import CharacterSpec
 from creaturegen.spec.gate import load_spec, validate_bytes
@@ -207,7 +209,7 @@ SETTLING = [n for n in ROPE_EXAMPLES if motion_data(n)["type"] != "hopper"]
 
 
 def _rope_local(motion: Motion) -> list[list[float]]:
-    return [motion.to_local_root(motion.root, x) for rope in motion.nodes for x in rope]
+    return [to_local_root(motion.root, x) for rope in motion.nodes for x in rope]
 
 
 @pytest.mark.parametrize("name", ROPE_EXAMPLES)

@@ -18,7 +18,7 @@ import pytest
 from conftest import build_example
 from creaturegen.creature import reference as cref
 from creaturegen.creature.pose import as_pose, pose_rows
-from creaturegen.lab.creature_parity import LAB_SEED, PARITY_TICK
+from creaturegen.lab.creature_lab import LAB_SEED, PARITY_TICK
 from creaturegen.model.genome import draw_genome, individual_size
 from creaturegen.model.rotations import Pose
 from creaturegen.motion.providers import AnalyticWater

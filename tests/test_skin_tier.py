@@ -18,8 +18,10 @@ from creaturegen.model import layout as col
 from creaturegen.model.graph import BlendGraph, Ref
 from creaturegen.rig import CompiledRig, compile_rig
 from creaturegen.spec import CharacterSpec, load_spec
-from creaturegen.surface.asset import SurfaceAsset, glb_bytes, parse_glb
-from creaturegen.surface.build import SKIN_PROGRAM, SurfaceBuild, build_surface
+from creaturegen.surface.asset import SurfaceAsset
+from creaturegen.surface.build import SurfaceBuild, build_surface
+from creaturegen.surface.correction_region import SKIN_PROGRAM
+from creaturegen.surface.glb import glb_bytes, parse_glb
 from creaturegen.surface.skin_tier import (
     MAX_REPORTED_PX,
     SUBPIXEL_PX,

@@ -16,14 +16,14 @@ import pytest
 from conftest import REPO, missing_setup
 from creaturegen import __version__
 from creaturegen.cachedir import default_cache_root
-from creaturegen.surface.asset import (
+from creaturegen.surface.asset import SurfaceAsset
+from creaturegen.surface.cache import SurfaceCache
+from creaturegen.surface.glb import (
     ARRAY_BUFFER,
     ELEMENT_ARRAY_BUFFER,
     UNSIGNED_INT,
     UNSIGNED_SHORT,
     GlbFormatError,
-    SurfaceAsset,
-    SurfaceCache,
     glb_bytes,
     parse_glb,
     read_glb,

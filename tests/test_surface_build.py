@@ -20,9 +20,11 @@ from creaturegen.creature.assets import surface_path
 from creaturegen.model.skeleton import build_skeleton
 from creaturegen.rig import compile_rig
 from creaturegen.spec import CharacterSpec, load_spec
-from creaturegen.surface import build as surface_build
-from creaturegen.surface.asset import SurfaceCache, parse_glb
-from creaturegen.surface.build import SurfaceBuild, SurfaceRejectedError, build_surface
+from creaturegen.surface import lattice, mesh_gates
+from creaturegen.surface.build import SurfaceBuild, build_surface
+from creaturegen.surface.cache import SurfaceCache
+from creaturegen.surface.glb import parse_glb
+from creaturegen.surface.refusal import SurfaceRejectedError
 
 #: Parts the field itself leaves detached (rope or antenna anchored beyond the parent's surface).
 DETACHED = {
@@ -99,8 +101,8 @@ def test_a_cache_hit_skips_extraction(cache_root: str) -> None:
 
 
 def test_a_failed_gate_stops_the_build_and_names_it(monkeypatch: pytest.MonkeyPatch) -> None:
-    monkeypatch.setattr(surface_build, "MIN_ANGLE_P1_DEG", 89.0)
-    monkeypatch.setattr(surface_build, "MAX_REFINEMENTS", 0)
+    monkeypatch.setattr(mesh_gates, "MIN_ANGLE_P1_DEG", 89.0)
+    monkeypatch.setattr(lattice, "MAX_REFINEMENTS", 0)
     spec = _spec("reference/hopper.json")
     with pytest.raises(SurfaceRejectedError, match=r"gate minAngleP1 = .* threshold 89"):
         build_surface(spec, compile_rig(spec), backend="numpy", cache=None, progress=lambda _: None)
@@ -111,7 +113,7 @@ def test_every_failed_mesh_gate_names_the_part_nearby() -> None:
     the body; each failed gate's detail names the part whose primitive is nearest its worst point."""
     s = rest_surface(REPO / "tests" / "fixtures" / "pincer.json", "hero")
     skeleton = build_skeleton(s.spec, s.rig)
-    gates, _ = surface_build.surface_mesh_gates(s.rig, s.extraction, s.field, skeleton, s.grid.spacing)
+    gates, _ = mesh_gates.surface_mesh_gates(s.rig, s.extraction, s.field, skeleton, s.grid.spacing)
     failed = {g.name: g.detail for g in gates if not g.passed}
     assert {"surfaceToZeroSet", "zeroSetToMesh", "vertexNormalAngleP99"} <= set(failed), failed
     parts = ("part.body", "part.claw-left", "part.claw-right")

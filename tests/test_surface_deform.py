@@ -22,9 +22,10 @@ from creaturegen.model import layout as col
 from creaturegen.model.rotations import Pose, posed_slots, rotation_matrix
 from creaturegen.model.skeleton import Skeleton, build_skeleton, pose_joint, subtree
 from creaturegen.rig import CompiledRig
-from creaturegen.surface import deform
+from creaturegen.surface import deform, skinning, sweep_gates
 from creaturegen.surface.field64 import BodyField
 from creaturegen.surface.mesh import Mesh
+from creaturegen.surface.sweep import sweep_poses
 from creaturegen.surface.weights import skin_weights
 
 F64 = npt.NDArray[np.float64]
@@ -111,13 +112,13 @@ def examples() -> dict[str, tuple[Body, deform.DeformationChoice]]:
     return out
 
 
-def _skin(method: str, body: Body, pose: Pose, centers: F64) -> deform.Skinned:
+def _skin(method: str, body: Body, pose: Pose, centers: F64) -> skinning.Skinned:
     v, n, i, w = body.mesh.vertices, body.normals, body.indices, body.weights
     if method == "lbs":
-        return deform.skin_lbs(v, n, i, w, pose)
+        return skinning.skin_lbs(v, n, i, w, pose)
     if method == "dq":
-        return deform.skin_dq(v, n, i, w, pose)
-    return deform.skin_cor(v, n, i, w, pose, centers)
+        return skinning.skin_dq(v, n, i, w, pose)
+    return skinning.skin_cor(v, n, i, w, pose, centers)
 
 
 def _signed_volume(vertices: F64, faces: npt.NDArray[np.int32]) -> float:
@@ -128,21 +129,21 @@ def _signed_volume(vertices: F64, faces: npt.NDArray[np.int32]) -> float:
 # ---------------------------------------------------------------------------------------- exactness
 
 
-@pytest.mark.parametrize("method", deform.METHODS)
+@pytest.mark.parametrize("method", skinning.METHODS)
 def test_identity_pose_reproduces_rest_exactly(biped: Body, method: str) -> None:
-    centers = deform.centers_of_rotation(biped.mesh, biped.indices, biped.weights)
+    centers = skinning.centers_of_rotation(biped.mesh, biped.indices, biped.weights)
     skinned = _skin(method, biped, Pose.identity(biped.rig.slot_count), centers)
     np.testing.assert_array_equal(skinned.positions, biped.mesh.vertices)
     np.testing.assert_allclose(skinned.normals, biped.normals, rtol=0, atol=1e-15)
     assert skinned.flips == 0
 
 
-@pytest.mark.parametrize("method", deform.METHODS)
+@pytest.mark.parametrize("method", skinning.METHODS)
 def test_rigid_motion_of_the_whole_body_is_reproduced_by_every_method(biped: Body, method: str) -> None:
     rotation = rotation_matrix([1.0, 2.0, 3.0], math.radians(137.0))
     translation = np.array([0.3, -1.2, 0.7])
     pose = Pose.rigid(biped.rig.slot_count, rotation, translation)
-    centers = deform.centers_of_rotation(biped.mesh, biped.indices, biped.weights)
+    centers = skinning.centers_of_rotation(biped.mesh, biped.indices, biped.weights)
     skinned = _skin(method, biped, pose, centers)
     expected = biped.mesh.vertices @ rotation.T + translation
     np.testing.assert_allclose(skinned.positions, expected, rtol=0, atol=1e-12 * biped.length)
@@ -173,7 +174,7 @@ def test_sweep_volume_matches_skinning_the_whole_mesh(chain: Body) -> None:
     choice = chain.choose()
     joint = choice.joints[0]
     rest_volume = _signed_volume(chain.mesh.vertices, chain.mesh.faces)
-    poses = deform.sweep_poses(chain.skeleton, chain.rig.slots, joint.child)
+    poses = sweep_poses(chain.skeleton, chain.rig.slots, joint.child)
     for sweep in joint.sweeps:
         direct = max(
             abs(
@@ -213,7 +214,7 @@ def test_dq_antipodality_keeps_a_200_degree_blend_continuous(chain: Body) -> Non
     axis = np.array([1.0, 0.0, 0.0])
     rotations = np.stack([rotation_matrix(axis, math.radians(a)) for a in (100.0, -100.0)])
     pose = Pose(rotations, pivot - rotations @ pivot)
-    skinned = deform.skin_dq(chain.mesh.vertices, chain.normals, chain.indices, chain.weights, pose)
+    skinned = skinning.skin_dq(chain.mesh.vertices, chain.normals, chain.indices, chain.weights, pose)
     assert skinned.flips > 0
     # Every blend of rotations about the pivot is a rotation about it: no vertex collapses.
     np.testing.assert_allclose(
@@ -224,7 +225,7 @@ def test_dq_antipodality_keeps_a_200_degree_blend_continuous(chain: Body) -> Non
     # One vertex across the whole weight range, through the dominance switch at s = 0.5.
     s = np.linspace(0.0, 1.0, 1001)
     point = pivot + np.array([0.0, 0.0, 0.08])
-    path = deform.skin_dq(
+    path = skinning.skin_dq(
         np.tile(point, (s.size, 1)),
         np.tile([0.0, 0.0, 1.0], (s.size, 1)),
         np.tile([0, 1], (s.size, 1)),
@@ -243,7 +244,7 @@ def test_dq_antipodality_keeps_a_200_degree_blend_continuous(chain: Body) -> Non
 
 
 def test_centers_of_rotation_sit_on_the_joint_axis(chain: Body) -> None:
-    centers = deform.centers_of_rotation(chain.mesh, chain.indices, chain.weights)
+    centers = skinning.centers_of_rotation(chain.mesh, chain.indices, chain.weights)
     blended = (chain.weights > 0).sum(axis=1) > 1
     assert blended.any()
     offset = centers[blended] - chain.skeleton.pivot[1]
@@ -256,9 +257,9 @@ def test_centers_of_rotation_sit_on_the_joint_axis(chain: Body) -> None:
 def test_skin_applies_each_vertex_its_joint_method(biped: Body) -> None:
     slot_count = biped.rig.slot_count
     pose = pose_joint(biped.skeleton, biped.rig.slots, 1, 0, math.radians(50.0), math.radians(20.0))
-    centers = deform.centers_of_rotation(biped.mesh, biped.indices, biped.weights)
-    for method in deform.METHODS:
-        mixed = deform.skin(
+    centers = skinning.centers_of_rotation(biped.mesh, biped.indices, biped.weights)
+    for method in skinning.METHODS:
+        mixed = skinning.skin(
             biped.mesh.vertices,
             biped.normals,
             biped.indices,
@@ -278,7 +279,7 @@ def test_skin_applies_each_vertex_its_joint_method(biped: Body) -> None:
 def test_no_passing_method_fails_naming_the_joint_and_gate(
     chain: Body, monkeypatch: pytest.MonkeyPatch
 ) -> None:
-    monkeypatch.setattr(deform, "SURFACE_MAX_FACTOR", 0.0)
+    monkeypatch.setattr(sweep_gates, "SURFACE_MAX_FACTOR", 0.0)
     with pytest.raises(deform.DeformationError, match=r"part\.lower.*surface_max") as info:
         chain.choose()
     assert info.value.joint == "part.lower"
@@ -293,7 +294,7 @@ def test_every_example_joint_gets_a_method(
     assert [(j.parent, j.child) for j in choice.joints] == body.skeleton.joints
     assert len(choice.methods) == body.rig.slot_count
     for joint in choice.joints:
-        assert joint.method in deform.METHODS
+        assert joint.method in skinning.METHODS
         assert choice.methods[joint.child] == joint.method
         assert joint.joint == body.skeleton.names[joint.child]
         assert all(g.passed for g in joint.gates)
@@ -301,7 +302,7 @@ def test_every_example_joint_gets_a_method(
     # The chosen methods skin a sweep pose to finite positions and unit normals.
     _, child = body.skeleton.joints[0]
     pose = pose_joint(body.skeleton, body.rig.slots, child, 1, math.radians(45.0), 0.0)
-    skinned = deform.skin(
+    skinned = skinning.skin(
         body.mesh.vertices,
         body.normals,
         body.indices,
@@ -323,7 +324,7 @@ def test_choice_never_returns_lbs_where_its_sweep_failed(
     for choice in choices:
         for joint in choice.joints:
             sweeps = {s.method: s for s in joint.sweeps}
-            first = next(m for m in deform.METHODS if sweeps[m].passed)
+            first = next(m for m in skinning.METHODS if sweeps[m].passed)
             assert joint.method == first
             assert (joint.method == "lbs") == sweeps["lbs"].passed
 
@@ -334,11 +335,11 @@ def test_relative_gates_compare_with_a_method_that_keeps_the_joint() -> None:
     marks a method once for the whole sweep: one that collapses at some pose is no alternative.)"""
     values = np.array([[0.001, 0.010, 0.006], [0.002, 0.003, 0.004]])
     keeps = np.array([[False, True, True], [True, True, True]])
-    excess = deform._excess(values, keeps)
+    excess = sweep_gates._excess(values, keeps)
     assert excess[0].tolist() == pytest.approx([0.0, 0.004, 0.0])
     assert excess[1].tolist() == pytest.approx([0.0, 0.001, 0.002])
     # Where no method keeps the joint, all three stay the reference (the absolute gates fail them).
-    assert np.array_equal(deform._excess(values, np.zeros_like(keeps)), deform._excess(values))
+    assert np.array_equal(sweep_gates._excess(values, np.zeros_like(keeps)), sweep_gates._excess(values))
 
 
 def test_a_refused_joint_says_how_far_the_motion_turns_it() -> None:
@@ -356,7 +357,7 @@ def test_a_refused_joint_says_how_far_the_motion_turns_it() -> None:
 
 
 def _corrector(body: Body) -> Any:
-    from creaturegen.surface.build import SKIN_ERROR_FACTOR, vertex_trust
+    from creaturegen.surface.correction_region import SKIN_ERROR_FACTOR, vertex_trust
 
     return deform.seam_corrector(
         body.mesh,
@@ -378,9 +379,9 @@ def test_a_joint_the_skin_alone_cannot_carry_passes_with_its_seam_corrected(
     (the chain's knee: 0.034 to 0.040 L at the sweep's extremes) and the corrected seam meets (0.005 L:
     the correction pulls the bulge back onto the posed field). The joint is kept, marked corrected, and
     its whole seam joins the correction region the runtime corrects."""
-    from creaturegen.surface.build import correction_sweep, seam
+    from creaturegen.surface.correction_region import correction_sweep, seam
 
-    monkeypatch.setattr(deform, "SURFACE_MAX_FACTOR", 0.25)
+    monkeypatch.setattr(sweep_gates, "SURFACE_MAX_FACTOR", 0.25)
     with pytest.raises(deform.DeformationError):
         chain.choose()
     choice = chain.choose(corrector=_corrector(chain))
@@ -408,7 +409,7 @@ def test_a_joint_the_skin_alone_cannot_carry_passes_with_its_seam_corrected(
 def test_a_joint_even_the_correction_cannot_carry_names_both_tries(
     chain: Body, monkeypatch: pytest.MonkeyPatch
 ) -> None:
-    monkeypatch.setattr(deform, "SURFACE_MAX_FACTOR", 0.0)
+    monkeypatch.setattr(sweep_gates, "SURFACE_MAX_FACTOR", 0.0)
     with pytest.raises(
         deform.DeformationError, match=r"part\.lower.*tried with the seam corrected.*surface_max"
     ):
@@ -419,16 +420,16 @@ def test_the_sweep_skins_its_seam_exactly_as_the_whole_mesh(biped: Body) -> None
     """correction_sweep skins only a seam and its one-ring (a 2 k-vertex seam on a 325 k-vertex body paid
     for every vertex at every pose). Those rows must be the whole-mesh skin's, bit for bit, for every
     method, and the ring must hold every corner of a face that touches the seam (``correct`` reads them)."""
-    from creaturegen.surface.build import _skin_near, seam
+    from creaturegen.surface.correction_region import _skin_near, seam
 
     pair = (biped.indices, biped.weights)
     choice = biped.choose()
     pose = pose_joint(biped.skeleton, biped.rig.slots, 1, 0, math.radians(50.0), math.radians(20.0))
     on_seam = seam(biped.skeleton, pair, 1)
     assert 0 < np.count_nonzero(on_seam) < biped.mesh.vertex_count // 2
-    for method in deform.METHODS:
+    for method in skinning.METHODS:
         methods = [method] * biped.rig.slot_count
-        every = deform.skin(
+        every = skinning.skin(
             biped.mesh.vertices, biped.normals, *pair, pose, methods, biped.skeleton, choice.centers
         )
         near = _skin_near(

@@ -385,7 +385,7 @@ def test_a_fused_field_changes_no_gate(sphere: Mesh) -> None:
 
 @pytest.mark.parametrize("bumpy", [False, True])
 def test_the_normal_gates_alone_equal_a_full_pass(sphere: Mesh, bumpy: bool) -> None:
-    """``normal_gates`` lets a remedy be turned down before a full pass (build._judged): its four gates
+    """``normal_gates`` lets a remedy be turned down before a full pass (remedies._judged): its four gates
     must be the full pass's, value for value and place for place, failing or not."""
 
     def field(p: F64) -> tuple[F64, F64]:

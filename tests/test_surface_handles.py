@@ -20,7 +20,7 @@ from creaturegen.model import layout as col
 from creaturegen.model.skeleton import build_skeleton
 from creaturegen.rig import compile_rig
 from creaturegen.spec import CharacterSpec, load_spec
-from creaturegen.surface.build import SurfaceRejectedError, build_surface
+from creaturegen.surface.build import build_surface
 from creaturegen.surface.handles import (
     Contact,
     _pieces,
@@ -32,6 +32,7 @@ from creaturegen.surface.handles import (
     uncut,
 )
 from creaturegen.surface.mesh import Mesh
+from creaturegen.surface.refusal import SurfaceRejectedError
 
 FIXTURES = Path(__file__).parent / "fixtures"
 PINCER = FIXTURES / "pincer.json"

@@ -10,9 +10,10 @@ import pytest
 from creaturegen.model.skeleton import build_skeleton
 from creaturegen.rig import compile_rig
 from creaturegen.spec import CharacterSpec, load_spec
-from creaturegen.surface import build
+from creaturegen.surface import lattice, remedies
 from creaturegen.surface.backends import NumpyBackend
-from creaturegen.surface.build import (
+from creaturegen.surface.grid import BLOCK, Grid
+from creaturegen.surface.lattice import (
     EXTRA_REFINEMENTS,
     MAX_REFINEMENTS,
     SMALL_LATTICE_NODES,
@@ -20,7 +21,6 @@ from creaturegen.surface.build import (
     _may_refine,
     validated_mesh,
 )
-from creaturegen.surface.grid import BLOCK, Grid
 from creaturegen.surface.sampling import _block_nodes
 
 #: Generated seed 4: a handle at its first three distant lattices that no unjoined pair makes certain.
@@ -51,8 +51,7 @@ def test_a_lower_tier_may_refine_as_far_as_the_hero_would() -> None:
     from conftest import EXAMPLES
     from creaturegen.rig import compile_rig
     from creaturegen.spec import CharacterSpec, load_spec
-    from creaturegen.surface.build import tier_offset
-    from creaturegen.surface.grid import ERROR_TARGET, make_grid, spacing_for
+    from creaturegen.surface.grid import ERROR_TARGET, make_grid, spacing_for, tier_offset
 
     spec = load_spec(EXAMPLES / "reference" / "hopper.json")
     assert isinstance(spec, CharacterSpec)
@@ -143,13 +142,13 @@ def _validated(path: Path, tier: str, said: list[str]) -> ValidatedMesh:
 
 def test_a_lattice_refined_for_its_genus_changes_no_result(monkeypatch: pytest.MonkeyPatch) -> None:
     """A lattice whose genus is wrong with no certain handle is refined without its other gates
-    (build._deferred). The generated quadruped closes a handle at its first three distant lattices: the
+    (lattice._deferred). The generated quadruped closes a handle at its first three distant lattices: the
     build must end where judging every lattice in full ends, with the same mesh and gate values."""
     said: list[str] = []
     quick = _validated(UNTIL_FINE, "distant", said)
     waited = [line for line in said if "the other gates wait" in line]
     assert len(waited) == 3, said
-    monkeypatch.setattr(build, "_deferred", lambda *args: None)
+    monkeypatch.setattr(lattice, "_deferred", lambda *args: None)
     full: list[str] = []
     eager = _validated(UNTIL_FINE, "distant", full)
     assert not any("the other gates wait" in line for line in full)
@@ -166,7 +165,7 @@ def test_when_every_lattice_has_the_wrong_genus_the_finest_is_reported(
 ) -> None:
     """With the budget cut to one refinement the quadruped's two lattices both close the handle: the
     report is the finer one, judged in full, and the coarser (deferred) one is never judged."""
-    monkeypatch.setattr(build, "_may_refine", lambda refinement, grid, tier="hero": refinement < 1)
+    monkeypatch.setattr(lattice, "_may_refine", lambda refinement, grid, tier="hero": refinement < 1)
     said: list[str] = []
     result = _validated(UNTIL_FINE, "distant", said)
     assert result.refinement == 1
@@ -193,10 +192,10 @@ def test_a_remedy_is_turned_down_early_only_when_no_full_pass_could_keep_it(
     """The other gates can only add failures: whenever ``_may_be_no_worse`` says no, every superset of
     ``some`` (what a full pass could find) fails ``_no_worse`` too, and when it says yes, ``some`` itself
     (a full pass that adds nothing) is kept."""
-    assert build._may_be_no_worse(failed, some) == expected
+    assert remedies._may_be_no_worse(failed, some) == expected
     others = ["euler", "selfIntersections", "surfaceToZeroSet"]
     supersets = [some + others[:n] for n in range(len(others) + 1)]
     if not expected:
-        assert not any(build._no_worse(failed, full) for full in supersets)
+        assert not any(remedies._no_worse(failed, full) for full in supersets)
     else:
-        assert build._no_worse(failed, some)
+        assert remedies._no_worse(failed, some)

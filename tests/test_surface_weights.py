@@ -247,6 +247,8 @@ def test_a_steep_weight_rim_is_split_before_the_build_refuses(monkeypatch: pytes
     without that remedy the same build is refused, naming the gate and the two tail segments."""
     from creaturegen.rig import compile_rig
     from creaturegen.surface import build as surface_build
+    from creaturegen.surface import remedies
+    from creaturegen.surface.refusal import SurfaceRejectedError
 
     spec = load_spec(STEEP_ROPE)
     assert isinstance(spec, CharacterSpec)
@@ -256,6 +258,6 @@ def test_a_steep_weight_rim_is_split_before_the_build_refuses(monkeypatch: pytes
     continuity = next(g for g in built.gates if g.name == "weights.continuity")
     assert continuity.value < 0.4
     assert any("split where a weight drops" in line for line in said), said
-    monkeypatch.setattr(surface_build, "WEIGHT_SPLIT_ROUNDS", 0)
-    with pytest.raises(surface_build.SurfaceRejectedError, match=r"weights\.continuity = 0\.40.*part\.tail"):
+    monkeypatch.setattr(remedies, "WEIGHT_SPLIT_ROUNDS", 0)
+    with pytest.raises(SurfaceRejectedError, match=r"weights\.continuity = 0\.40.*part\.tail"):
         surface_build.build_surface(spec, compile_rig(spec), backend="numpy", progress=lambda _: None)

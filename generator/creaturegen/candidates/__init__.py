@@ -9,7 +9,7 @@ from ..motion.envelope import PoseEnvelope, pose_envelope
 from ..rig import CompiledRig
 from ..spec import CharacterSpec
 from .program import CandidateProgram, Certificate
-from .regions import TIERS, Tier, TierRejectedError, Tolerances, search
+from .regions import DEFAULT_TIER, TIERS, Tier, TierRejectedError, Tolerances, search
 from .sweep import SweepResult, run_sweep
 
 #: Band τ around the surface that programs must reproduce, as a fraction of the body size L.
@@ -21,6 +21,7 @@ MAX_NORMAL_ANGLE_DEG = 0.05
 MAX_DELTA_E_OKLAB = 0.002
 
 __all__ = [
+    "DEFAULT_TIER",
     "TIERS",
     "CandidateProgram",
     "CandidateSet",

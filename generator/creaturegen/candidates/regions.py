@@ -61,6 +61,8 @@ TIERS = {
     "repeated": Tier("repeated", 6, 8, SkinTolerance(10.0, 0.02)),
     "distant": Tier("distant", 4, 4, SkinTolerance(20.0, 0.04)),
 }
+#: The tier a build makes unless told otherwise: the one every example's candidate programs accept.
+DEFAULT_TIER = "hero"
 
 
 @dataclass(frozen=True)

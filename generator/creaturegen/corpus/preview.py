@@ -17,7 +17,7 @@ import numpy.typing as npt
 from ..field.sampler import sample
 from ..lab.png import write_png
 from ..rig import CompiledRig
-from ..surface.asset import read_glb
+from ..surface.glb import read_glb
 
 #: View direction (towards the camera) and light direction, creature space (Y up, +Z forward).
 VIEW = np.array([0.75, 0.45, 0.95])

@@ -11,9 +11,10 @@ from ..emit.render import render_folder, to_json
 from ..emit.writer import PackageFile, header_text, write_package
 from ..rig import CompiledRig
 from ..spec import CharacterSpec, slugify
-from ..surface.asset import glb_bytes, sidecar_bytes
-from ..surface.build import SurfaceBuild, posed_gate_rows
+from ..surface.build import SurfaceBuild
 from ..surface.emit import stable_sidecar
+from ..surface.glb import glb_bytes, sidecar_bytes
+from ..surface.sidecar import posed_gate_rows
 from .assets import PICTURE_PATH, REPORT_PATH, SIDECAR_PATH, SPEC_PATH, shipped_files, shipped_spec
 from .plan import build_plan
 

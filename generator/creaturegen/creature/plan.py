@@ -26,8 +26,9 @@ from ..rig import CompiledRig
 from ..spec import CharacterSpec, slugify
 from ..spec.character import LocomotionType
 from ..surface import correct as correction
-from ..surface.build import NO_PROGRAM, SKIN_PROGRAM, SurfaceBuild
-from ..surface.deform import METHODS
+from ..surface.build import SurfaceBuild
+from ..surface.correction_region import NO_PROGRAM, SKIN_PROGRAM
+from ..surface.skinning import METHODS
 from .assets import asset_plan
 from .pose import POSE_ROWS
 from .tape import Tape, compile_tape
@@ -101,12 +102,55 @@ def build_plan(
     skeleton = build_skeleton(spec, rig)
     motion = build_motion(spec, rig, skeleton)
     tapes, note = program_tapes(spec, rig, surface.tier, surface.candidates)
-    floors = floors_for(rig.body_scale)
-    asset = surface.asset
-    skin = np.asarray(asset.skin)  # (V, 2): method code, trust radius
     slug = slugify(spec.name)
     assets = asset_plan(slug, surface.signatures["geometryDigest"])
-    runtime: dict[str, Any] = {
+    runtime = _runtime(spec, rig, surface, spec_sha256, skeleton, motion, tapes, note, slug, assets)
+    workload = _workload(rig, surface, runtime, tapes)
+    skin = np.asarray(surface.asset.skin)  # (V, 2): method code, trust radius
+    plan: dict[str, Any] = {
+        "name": spec.name,
+        "slug": runtime["slug"],
+        "version": __version__,
+        "specSha256": spec_sha256,
+        "runtime": runtime,
+        "assets": assets,
+        "three": THREE_RELEASE,
+        "usage": _usage(motion),
+        # The package README's gait-gene line (each gene scales its fields together).
+        "genes": "; ".join(" with ".join(g) for g in motion["genes"]["fields"]) or "nothing (no locomotion)",
+        "sizeRange": f"{1.0 - spec.genetics.size:g} to {1.0 + spec.genetics.size:g}",
+        "signatures": dict(surface.signatures),
+        "tier": surface.tier,
+        "gates": [g.as_dict() for g in surface.gates],
+        "representation": _representation(workload["fieldVertices"], surface.asset.vertex_count),
+        "workload": workload,
+        "methods": {m: int(np.count_nonzero(skin[:, 0] == i)) for i, m in enumerate(METHODS)},
+        # The string unions of core/index.d.ts, from the Python definitions the runtime data comes from.
+        "types": {
+            "debugMode": list(DEBUG_MODES),
+            "tierName": list(TIERS),
+            "locomotionType": list(get_args(LocomotionType)),
+        },
+    }
+    return CreaturePlan(plan, tuple(tapes), skeleton)
+
+
+def _runtime(
+    spec: CharacterSpec,
+    rig: CompiledRig,
+    surface: SurfaceBuild,
+    spec_sha256: str,
+    skeleton: Skeleton,
+    motion: dict[str, Any],
+    tapes: list[Tape],
+    note: str,
+    slug: str,
+    assets: dict[str, Any],
+) -> dict[str, Any]:
+    """``plan["runtime"]``: the data core/data.js holds."""
+    floors = floors_for(rig.body_scale)
+    asset = surface.asset
+    return {
         "name": spec.name,
         "slug": slug,
         "version": __version__,
@@ -149,15 +193,26 @@ def build_plan(
         "debugModes": list(DEBUG_MODES),
         "deformStride": DEFORM_STRIDE,
     }
+
+
+def _usage(motion: dict[str, Any]) -> dict[str, str]:
+    """The README's minimal page (examples/minimal.js): a swimmer needs a water provider (the template
+    only prints these)."""
     swims = motion["type"] == "swimmer"
-    # The README's minimal page (examples/minimal.js): a swimmer needs a water provider (the template
-    # only prints these).
     water = ["createAnalyticWater"] if swims else []
-    usage = {
+    return {
         "imports": ", ".join(["CREATURE", *water, "createCreaturePopulation"]),
         "options": "{ capacity: 64, water: createAnalyticWater() }" if swims else "{ capacity: 64 }",
         "water": " and `water` (required: this creature swims)" if swims else "",
     }
+
+
+def _workload(
+    rig: CompiledRig, surface: SurfaceBuild, runtime: dict[str, Any], tapes: list[Tape]
+) -> dict[str, Any]:
+    """``plan["workload"]``: what one body costs per frame at this tier (the README's workload table)."""
+    asset = surface.asset
+    skin = np.asarray(asset.skin)  # (V, 2): method code, trust radius
     corrected = int(np.count_nonzero(skin[:, 1] > 0))
     # Leaf evaluations per body and frame: each field vertex runs its own program once at its final
     # position (E_snap adds the correction trials of corrected vertices); a skin vertex runs none.
@@ -167,42 +222,17 @@ def build_plan(
     leaf_evaluations = int(
         per_program[np.where(program[in_field] == NO_PROGRAM, len(tapes) - 1, program[in_field])].sum()
     )
-    plan: dict[str, Any] = {
-        "name": spec.name,
-        "slug": runtime["slug"],
-        "version": __version__,
-        "specSha256": spec_sha256,
-        "runtime": runtime,
-        "assets": assets,
-        "three": THREE_RELEASE,
-        "usage": usage,
-        # The package README's gait-gene line (each gene scales its fields together).
-        "genes": "; ".join(" with ".join(g) for g in motion["genes"]["fields"]) or "nothing (no locomotion)",
-        "sizeRange": f"{1.0 - spec.genetics.size:g} to {1.0 + spec.genetics.size:g}",
-        "signatures": dict(surface.signatures),
+    return {
         "tier": surface.tier,
-        "gates": [g.as_dict() for g in surface.gates],
-        "representation": _representation(int(in_field.sum()), asset.vertex_count),
-        "workload": {
-            "tier": surface.tier,
-            "slots": rig.slot_count,
-            "K": runtime["registers"],
-            "programs": len(tapes),
-            "vertices": asset.vertex_count,
-            "triangles": runtime["mesh"]["triangles"],
-            "correctedVertices": corrected,
-            "fieldVertices": int(in_field.sum()),
-            "leafEvaluationsPerBody": leaf_evaluations,
-            "poseBytesPerBody": runtime["maxParts"] * POSE_ROWS * 16,
-            # The deform pre-pass storage (tsl/deform.js DEFORM_STRIDE vec4 per vertex).
-            "deformBytesPerBody": asset.vertex_count * DEFORM_STRIDE * 16,
-        },
-        "methods": {m: int(np.count_nonzero(skin[:, 0] == i)) for i, m in enumerate(METHODS)},
-        # The string unions of core/index.d.ts, from the Python definitions the runtime data comes from.
-        "types": {
-            "debugMode": list(DEBUG_MODES),
-            "tierName": list(TIERS),
-            "locomotionType": list(get_args(LocomotionType)),
-        },
+        "slots": rig.slot_count,
+        "K": runtime["registers"],
+        "programs": len(tapes),
+        "vertices": asset.vertex_count,
+        "triangles": runtime["mesh"]["triangles"],
+        "correctedVertices": corrected,
+        "fieldVertices": int(in_field.sum()),
+        "leafEvaluationsPerBody": leaf_evaluations,
+        "poseBytesPerBody": runtime["maxParts"] * POSE_ROWS * 16,
+        # The deform pre-pass storage (tsl/deform.js DEFORM_STRIDE vec4 per vertex).
+        "deformBytesPerBody": asset.vertex_count * DEFORM_STRIDE * 16,
     }
-    return CreaturePlan(plan, tuple(tapes), skeleton)

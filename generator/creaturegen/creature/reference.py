@@ -1,6 +1,6 @@
 """The Python side of the creature parity job: what the lab's GPU readbacks are compared against.
 
-Everything here is the float64 reference (field/sampler.py, surface/deform.py, motion/simulate.py),
+Everything here is the float64 reference (field/sampler.py, surface/skinning.py, motion/simulate.py),
 rebuilt from the package's own ``assets/spec.json`` and surface .glb (creature/assets.py names it);
 nothing is read from the package's JS or computed by the browser.
 """
@@ -26,9 +26,10 @@ from ..motion.rig import build_motion
 from ..motion.simulate import Motion
 from ..rig import CompiledRig, compile_rig
 from ..spec import CharacterSpec, validate_bytes
-from ..surface.asset import SurfaceAsset, read_glb
-from ..surface.build import SKIN_PROGRAM
-from ..surface.deform import skin_cor, skin_dq, skin_lbs
+from ..surface.asset import SurfaceAsset
+from ..surface.correction_region import SKIN_PROGRAM
+from ..surface.glb import read_glb
+from ..surface.skinning import skin_cor, skin_dq, skin_lbs
 from .assets import SPEC_PATH, surface_path
 from .pose import sized_graph, sized_slots
 
@@ -139,7 +140,7 @@ def blend_pairs(rig: CompiledRig) -> list[tuple[int, int]]:
 
 
 def skinned_vertices(ref: PackageReference, pose: Pose, size: float = 1.0) -> tuple[F64, F64]:
-    """Each vertex skinned in float64 by its baked method (LBS, DQ or CoR), as surface/deform.py does:
+    """Each vertex skinned in float64 by its baked method (LBS, DQ or CoR), as surface/skinning.py does:
     positions and the skinned rest normals (LBS by the cofactor of the blended matrix, DQ and CoR by the
     blended rotation, unit). An individual of ``size`` skins its rest vertices and centres of rotation
     scaled by it (a similarity: the normals do not change)."""

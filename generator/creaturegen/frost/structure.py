@@ -307,11 +307,34 @@ def _crystal_strip(
     """Crystal density of a strip: per-cell dendrites (arms, 60° side branches, nucleus), grain edges.
 
     The nearest nucleus (F1) and the second-nearest distance (F2) come from the 3×3 neighbouring jittered
-    cells (nuclei stay within [0.15, 0.85] of their cell, so 3×3 suffices). Only the owning crystal's
-    dendrite is drawn, so arms stop where neighbouring crystals begin, as growing crystals do when they
-    meet. A texel's grid cell is separable (its column picks the cell column, its row the cell row), so
-    per-cell values reach the texels through two 1-D ``take``s, and the nearest of the 9 candidates is
-    carried as a one-byte offset code until the end.
+    cells (``_nearest_nuclei``). Only the owning crystal's dendrite is drawn (``_dendrite``), so arms stop
+    where neighbouring crystals begin, as growing crystals do when they meet.
+    """
+    own, dx, dy, best, second = _nearest_nuclei(local_v, grid_v, local_u, grid_u, cells)
+    r = np.sqrt(best)
+    gap = np.sqrt(second) - r  # F2 − F1: zero on the boundary between two crystals
+    dendrite = _dendrite(own, dx, dy, r, branches, sharpness, cells)
+    # Crystals are denser near their nucleus; the boundaries where crystals meet are faint ridges.
+    body = np.float32(0.18) * np.clip(1.0 - r / np.float32(0.75), 0.0, 1.0)
+    boundary = np.float32(0.35) * _ridge(gap / np.float32(0.05), sharpness)
+    density: F32 = np.maximum(dendrite + body, boundary).astype(np.float32)
+    return density
+
+
+def _nearest_nuclei(
+    local_v: F32,
+    grid_v: npt.NDArray[np.intp],
+    local_u: F32,
+    grid_u: npt.NDArray[np.intp],
+    cells: _Cells,
+) -> tuple[npt.NDArray[np.intp], F32, F32, F32, F32]:
+    """Per texel of a strip: the flat index of its owning (nearest) cell, the offset (dx, dy) from that
+    cell's nucleus, and the squared distances F1² and F2² to the nearest and second-nearest nuclei.
+
+    Nuclei stay within [0.15, 0.85] of their cell, so the 3×3 neighbouring jittered cells suffice. A
+    texel's grid cell is separable (its column picks the cell column, its row the cell row), so per-cell
+    values reach the texels through two 1-D ``take``s, and the nearest of the 9 candidates is carried as a
+    one-byte offset code until the end.
     """
     side = cells.jitter.shape[0]
     lx = local_u[None, :]  # columns: u
@@ -341,9 +364,20 @@ def _crystal_strip(
     own = (grid_v[:, None] + step_v + 1) * side + (grid_u[None, :] + step_u + 1)
     dx = lx - (step_u + jit_x.ravel().take(own))
     dy = ly - (step_v + jit_y.ravel().take(own))
-    r = np.sqrt(best)
-    gap = np.sqrt(second) - r  # F2 − F1: zero on the boundary between two crystals
+    return own, dx, dy, best, second
 
+
+def _dendrite(
+    own: npt.NDArray[np.intp],
+    dx: F32,
+    dy: F32,
+    r: F32,
+    branches: int,
+    sharpness: float,
+    cells: _Cells,
+) -> F32:
+    """The owning crystal's dendrite at each texel of a strip: ``branches`` curled, twisted arms feathered
+    with 60° side branches, and the nucleus, scaled by the crystal's vigour."""
     # Arms: the angle to the nearest of `branches` evenly spaced, curled and twisted arm directions.
     sector = np.float32(2.0 * np.pi / branches)
     theta = np.arctan2(dy, dx)
@@ -375,12 +409,8 @@ def _crystal_strip(
 
     nucleus = _ridge(r / np.float32(0.09), sharpness)
     vigour = cells.vigour.astype(np.float32).ravel().take(own)
-    dendrite = np.maximum(np.maximum(main, np.float32(0.8) * sides), nucleus) * vigour
-    # Crystals are denser near their nucleus; the boundaries where crystals meet are faint ridges.
-    body = np.float32(0.18) * np.clip(1.0 - r / np.float32(0.75), 0.0, 1.0)
-    boundary = np.float32(0.35) * _ridge(gap / np.float32(0.05), sharpness)
-    density: F32 = np.maximum(dendrite + body, boundary).astype(np.float32)
-    return density
+    dendrite: F32 = np.maximum(np.maximum(main, np.float32(0.8) * sides), nucleus) * vigour
+    return dendrite
 
 
 def _ridge(distance: Floats, sharpness: float) -> F32:

@@ -45,7 +45,7 @@ def picture_unavailable() -> str | None:
 
 def render_picture(package: Path) -> bytes:
     """PNG bytes of body 0 of ``package`` (a package folder, possibly not yet committed) in the lab."""
-    from .creature_parity import open_creature_lab
+    from .creature_lab import open_creature_lab
 
     with open_creature_lab(package, PICTURE_SIZE, seed=PICTURE_SEED, capacity=1, pageSize=1) as page:
         page.evaluate(f"() => window.__lab.seekTick({PICTURE_TICK})")

@@ -21,7 +21,7 @@ from . import quat as vq
 PATH_RADIUS_BODIES: Final = 6.0
 #: Share of a leg's room to full extension (reachMax less its rest hip-foot distance) that an upright
 #: body on a slope may ask of its downhill legs, so it sits higher than its lowest foot
-#: (simulate.Motion._settle): halfway between its lowest and highest rest foot, where that room allows.
+#: (motion/root.py settle): halfway between its lowest and highest rest foot, where that room allows.
 SETTLE_SLACK: Final = 0.25
 #: Swing time ``SWING_FROUDE·sqrt(leg/g)`` (dynamic similarity: equal Froude number across leg lengths).
 SWING_FROUDE: Final = 1.0
@@ -114,12 +114,74 @@ def build_motion(spec: CharacterSpec, rig: CompiledRig, skeleton: Skeleton) -> d
     loco = spec.locomotion
     kind = loco.type if loco is not None else "none"
     slots = rig.slots
+    by_part = _slots_by_part(rig)
+    body = float(rig.body_scale)
+    phases = sorted({float(p.phase or 0.0) for p in spec.parts if p.shape == "leg"})
+    legs = _legs(spec, rig, by_part, phases)
+    ropes = _ropes(spec, rig, skeleton, by_part)
+    wings = _wings(spec, rig, by_part)
+    step_spec = float(fields_of(loco).get("stepLength", 0.0)) * spec.scale
+    ground, step_limit = _ground_and_step_limit(legs, rig)
+    roots = [s for s in range(rig.slot_count) if skeleton.parent[s] < 0]
+    centre_y = sum(0.5 * (float(slots[r, 1]) + float(slots[r, 5])) for r in roots) / len(roots)
+    fields = fields_of(loco)
+    speed = float(fields.get("speed", 0.0))
+    return dict(
+        _plain(
+            {
+                "type": kind,
+                "hz": int(fields.get("tickRate", 60)),
+                "speed": speed,
+                "bodyScale": body,
+                "groundY": ground,
+                "centreY": centre_y,
+                "pathRadius": float(fields["radius"]) * spec.scale
+                if kind == "flyer"
+                else PATH_RADIUS_BODIES * body,
+                "stepLength": min(step_spec, step_limit) if legs else step_spec,
+                "stepLengthSpec": step_spec,
+                "stepLimit": step_limit,
+                "stepHeight": float(fields.get("stepHeight", 0.0)) * spec.scale,
+                "hopLength": float(fields.get("hopLength", 0.0)) * spec.scale,
+                "hopHeight": float(fields.get("hopHeight", 0.0)) * spec.scale,
+                "altitude": float(fields.get("altitude", 0.0)) * spec.scale,
+                "undulation": float(fields.get("undulation", 0.0)),
+                "buoyancy": float(fields.get("buoyancy", 1.0)),
+                "groups": len(phases),
+                "legs": legs,
+                "ropes": ropes,
+                "wings": wings,
+                "roots": roots,
+                "parent": list(skeleton.parent),
+                "order": list(skeleton.order),
+                "pivot": [_v(p) for p in skeleton.pivot],
+                "constants": _constants(),
+                # Rope nodes of creatures that stand on the support stay above it by their radius.
+                "ropeGround": kind in WALKERS or kind == "hopper",
+                "genes": {
+                    "jitter": spec.genetics.gait,
+                    "fields": [list(g) for g in GAIT_GENES.get(kind, ())],
+                    "size": spec.genetics.size,
+                },
+                "lengths": {group: list(names) for group, names in SIZED_FIELDS.items()},
+            }
+        )
+    )
+
+
+def _slots_by_part(rig: CompiledRig) -> dict[str, list[int]]:
+    """Part id -> its slots, in slot order."""
     by_part: dict[str, list[int]] = {}
     for index, owner in enumerate(rig.slot_parts):
         by_part.setdefault(owner, []).append(index)
-    body = float(rig.body_scale)
+    return by_part
 
-    phases = sorted({float(p.phase or 0.0) for p in spec.parts if p.shape == "leg"})
+
+def _legs(
+    spec: CharacterSpec, rig: CompiledRig, by_part: dict[str, list[int]], phases: list[float]
+) -> list[dict[str, Any]]:
+    """Every leg part's two slots, rest joints, bone lengths, knee hint and hinge, reach and phase group."""
+    slots = rig.slots
     legs: list[dict[str, Any]] = []
     for part in spec.parts:
         if part.shape != "leg":
@@ -156,11 +218,19 @@ def build_motion(spec: CharacterSpec, rig: CompiledRig, skeleton: Skeleton) -> d
                 "reachMin": reach_min,
                 "reachMax": (a + b) * (1.0 - REACH_MARGIN),
                 # A hopper's foot at the apex: hip + (foot − hip)·tuck (a ratio, so an individual's size
-                # scales it with hip and foot; motion/simulate.py _hop_legs).
+                # scales it with hip and foot; motion/hop.py hop_legs).
                 "tuck": (reach_min + HOP_TUCK * (drop - reach_min)) / drop,
                 "crouch": HOP_CROUCH_DEPTH,
             }
         )
+    return legs
+
+
+def _ropes(
+    spec: CharacterSpec, rig: CompiledRig, skeleton: Skeleton, by_part: dict[str, list[int]]
+) -> list[dict[str, Any]]:
+    """Every rope part's chain of slots, rest nodes and radii, segment length and bend limit."""
+    slots = rig.slots
     ropes = []
     for part in spec.parts:
         if part.shape != "rope":
@@ -180,11 +250,17 @@ def build_motion(spec: CharacterSpec, rig: CompiledRig, skeleton: Skeleton) -> d
                 "radius": radius,
                 "segment": segment,
                 "bendMin": 2.0 * segment * math.cos(math.radians(ROPE_BEND_LIMIT_DEG) / 2.0),
-                # The follow-the-leader pass's cone (simulate.py _follow): cosine and sine of the limit.
+                # The follow-the-leader pass's cone (motion/ropes.py follow): cosine and sine of the limit.
                 "bendCos": math.cos(math.radians(ROPE_BEND_LIMIT_DEG)),
                 "bendSin": math.sin(math.radians(ROPE_BEND_LIMIT_DEG)),
             }
         )
+    return ropes
+
+
+def _wings(spec: CharacterSpec, rig: CompiledRig, by_part: dict[str, list[int]]) -> list[dict[str, Any]]:
+    """Every flapping part's slot, flap side and amplitude, and length."""
+    slots = rig.slots
     wings = []
     for part in spec.parts:
         if part.flap is None:
@@ -200,7 +276,13 @@ def build_motion(spec: CharacterSpec, rig: CompiledRig, skeleton: Skeleton) -> d
                 "length": math.dist(start, end),
             }
         )
-    step_spec = float(fields_of(loco).get("stepLength", 0.0)) * spec.scale
+    return wings
+
+
+def _ground_and_step_limit(legs: list[dict[str, Any]], rig: CompiledRig) -> tuple[float, float]:
+    """The rest ground height (the legs' mean rest foot height, else the lowest point of any slot) and the
+    cap on a step's lag (REACH_STEP_FRACTION of the shortest leg's horizontal reach at rest hip height, 0
+    without legs)."""
     step_limit = 0.0
     if legs:
         ground = sum(leg["foot"][1] for leg in legs) / len(legs)
@@ -209,66 +291,27 @@ def build_motion(spec: CharacterSpec, rig: CompiledRig, skeleton: Skeleton) -> d
         ]
         step_limit = REACH_STEP_FRACTION * min(horizontal)
     else:
-        ground = float(min(min(s[1] - s[3], s[5] - s[7]) for s in slots.tolist()))
-    roots = [s for s in range(rig.slot_count) if skeleton.parent[s] < 0]
-    centre_y = sum(0.5 * (float(slots[r, 1]) + float(slots[r, 5])) for r in roots) / len(roots)
-    fields = fields_of(loco)
-    speed = float(fields.get("speed", 0.0))
-    return dict(
-        _plain(
-            {
-                "type": kind,
-                "hz": int(fields.get("tickRate", 60)),
-                "speed": speed,
-                "bodyScale": body,
-                "groundY": ground,
-                "centreY": centre_y,
-                "pathRadius": float(fields["radius"]) * spec.scale
-                if kind == "flyer"
-                else PATH_RADIUS_BODIES * body,
-                "stepLength": min(step_spec, step_limit) if legs else step_spec,
-                "stepLengthSpec": step_spec,
-                "stepLimit": step_limit,
-                "stepHeight": float(fields.get("stepHeight", 0.0)) * spec.scale,
-                "hopLength": float(fields.get("hopLength", 0.0)) * spec.scale,
-                "hopHeight": float(fields.get("hopHeight", 0.0)) * spec.scale,
-                "altitude": float(fields.get("altitude", 0.0)) * spec.scale,
-                "undulation": float(fields.get("undulation", 0.0)),
-                "buoyancy": float(fields.get("buoyancy", 1.0)),
-                "groups": len(phases),
-                "legs": legs,
-                "ropes": ropes,
-                "wings": wings,
-                "roots": roots,
-                "parent": list(skeleton.parent),
-                "order": list(skeleton.order),
-                "pivot": [_v(p) for p in skeleton.pivot],
-                "constants": {
-                    "swingFroude": SWING_FROUDE,
-                    "stepLead": STEP_LEAD,
-                    "settleSlack": SETTLE_SLACK,
-                    "hopCrouchS": HOP_CROUCH_S,
-                    "hopLandS": HOP_LAND_S,
-                    "hopSquash": HOP_SQUASH,
-                    "hopStretch": HOP_STRETCH,
-                    "strouhal": STROUHAL,
-                    "swimResponse": SWIM_RESPONSE,
-                    "ropeSubsteps": ROPE_SUBSTEPS,
-                    "ropePasses": ROPE_PASSES,
-                    "ropeDamping": ROPE_DAMPING,
-                    "ropeBendLimitDeg": ROPE_BEND_LIMIT_DEG,
-                },
-                # Rope nodes of creatures that stand on the support stay above it by their radius.
-                "ropeGround": kind in WALKERS or kind == "hopper",
-                "genes": {
-                    "jitter": spec.genetics.gait,
-                    "fields": [list(g) for g in GAIT_GENES.get(kind, ())],
-                    "size": spec.genetics.size,
-                },
-                "lengths": {group: list(names) for group, names in SIZED_FIELDS.items()},
-            }
-        )
-    )
+        ground = float(min(min(s[1] - s[3], s[5] - s[7]) for s in rig.slots.tolist()))
+    return ground, step_limit
+
+
+def _constants() -> dict[str, Any]:
+    """The stated constants the motion reads (this module's), shipped with the data."""
+    return {
+        "swingFroude": SWING_FROUDE,
+        "stepLead": STEP_LEAD,
+        "settleSlack": SETTLE_SLACK,
+        "hopCrouchS": HOP_CROUCH_S,
+        "hopLandS": HOP_LAND_S,
+        "hopSquash": HOP_SQUASH,
+        "hopStretch": HOP_STRETCH,
+        "strouhal": STROUHAL,
+        "swimResponse": SWIM_RESPONSE,
+        "ropeSubsteps": ROPE_SUBSTEPS,
+        "ropePasses": ROPE_PASSES,
+        "ropeDamping": ROPE_DAMPING,
+        "ropeBendLimitDeg": ROPE_BEND_LIMIT_DEG,
+    }
 
 
 def _plain(value: Any, place: str = "motion") -> Any:

@@ -68,7 +68,7 @@ LEG_COUNTS: dict[str, int] = {
     "swimmer": 0,
 }
 
-#: Types whose legs walk: one gait (motion/simulate.py) plants and lifts their feet by phase group, so they
+#: Types whose legs walk: one gait (motion/gait.py) plants and lifts their feet by phase group, so they
 #: differ only in the leg count they require. The motion reference, the envelope and the JS core read this
 #: tuple (the JS core a copy of it, pinned by the motion parity test).
 WALKERS: tuple[str, ...] = ("biped", "quadruped", "hexapod", "octopod", "walker")
@@ -78,8 +78,8 @@ WALKERS: tuple[str, ...] = ("biped", "quadruped", "hexapod", "octopod", "walker"
 WALKER_LEG_COUNTS: tuple[int, ...] = (2, 4, 6, 8)
 
 #: Leg counts of a ``hopper``: none (the body hops on its own squash) or the two hind legs it hops on, a
-#: kangaroo's or a frog's. Both legs plant, push off, tuck and land together (motion/simulate.py
-#: _hop_legs), whatever their ``phase``.
+#: kangaroo's or a frog's. Both legs plant, push off, tuck and land together (motion/hop.py
+#: hop_legs), whatever their ``phase``.
 HOPPER_LEG_COUNTS: tuple[int, ...] = (0, 2)
 
 BLEND_KERNELS = ("log-sum-exp",)

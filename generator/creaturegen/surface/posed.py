@@ -2,7 +2,7 @@
 
 The rest mesh is gated on its orientation against the field (``inverted``) and on self-intersections
 (surface/gates.py). Skinning and the bounded correction then move every vertex, and the joint sweeps
-(surface/deform.py) only measure one joint turned at a time, on its own seam. Here the mesh as the
+(surface/sweep.py) only measure one joint turned at a time, on its own seam. Here the mesh as the
 runtime draws it (each vertex skinned by its joint's method, the correction-region vertices corrected
 toward the posed field within their trust radius) is taken to each pose of the envelope
 (motion/envelope.py: poses of real cycles, every joint turned at once, chosen by farthest-point
@@ -46,7 +46,7 @@ from ..field.primitives import primitive_distance
 from ..model.rotations import Pose, posed_slots
 from ..model.skeleton import Skeleton
 from ..rig import CompiledRig
-from . import deform
+from . import deform, joint_sets, skinning
 from .correct import correct
 from .field64 import BodyField
 from .gates import DISTANCE_TOL, SurfaceGate
@@ -129,10 +129,10 @@ def choice_skinner(
     skeleton: Skeleton,
     choice: deform.DeformationChoice,
 ) -> Skinner:
-    """The build's skin: :func:`deform.skin` with the chosen methods."""
+    """The build's skin: :func:`skinning.skin` with the chosen methods."""
 
     def skin(pose: Pose) -> tuple[F64, F64]:
-        s = deform.skin(
+        s = skinning.skin(
             mesh.vertices, normals, weights[0], weights[1], pose, choice.methods, skeleton, choice.centers
         )
         return s.positions, s.normals
@@ -367,7 +367,7 @@ def posed_quality(
 ) -> PosedQuality:
     """Every envelope pose measured (see the module docstring); ``radius`` is the runtime's correction
     trust radius per vertex (zero outside the correction region)."""
-    edges = deform.edge_faces(mesh.faces.astype(np.int64))
+    edges = joint_sets.edge_faces(mesh.faces.astype(np.int64))
     rest_n = unit_rows(mesh.face_normals())
     rest_turn = angles_deg(rest_n[edges[:, 0]], rest_n[edges[:, 1]])
     tree = triangle_bvh(mesh)

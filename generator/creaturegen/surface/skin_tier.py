@@ -3,7 +3,7 @@
 The seed's rule for bodies that cover few pixels is to change representation before shaving constants:
 where the skinned reference mesh alone stays within the tier's error, the live field correction, its
 candidate program and the per-vertex field evaluation go. A skin vertex is drawn at its skinned position
-with its skinned rest normal (surface/deform.py; for LBS the formulas of a three.js SkinnedMesh) and a
+with its skinned rest normal (surface/skinning.py; for LBS the formulas of a three.js SkinnedMesh) and a
 colour baked from the field's proximity-colour kernel at rest: the BAKED_LEAVES leaves of largest weight,
 renormalised. The colours stay per individual (genetic colour variation reads the pose rows); only the
 weights are baked.
@@ -35,7 +35,7 @@ from ..model.rotations import Pose, posed_slots
 from ..model.skeleton import Skeleton
 from ..rig import CompiledRig
 from ..rig.colour import linear_to_oklab
-from . import deform
+from . import deform, skinning
 from .mesh import Mesh
 
 F64 = npt.NDArray[np.float64]
@@ -117,7 +117,7 @@ def skin_departures(
     own = np.zeros((mesh.vertex_count, rig.slot_count), dtype=bool)
     np.put_along_axis(own, weights[0].astype(np.int64), weights[1] > 0.0, axis=1)
     for pose in (Pose.identity(rig.slot_count), *poses):
-        skinned = deform.skin(
+        skinned = skinning.skin(
             mesh.vertices, normals, weights[0], weights[1], pose, choice.methods, skeleton, choice.centers
         )
         table = posed_slots(rig.slots, pose)

@@ -1,5 +1,5 @@
 // Skinning the reference mesh from the pose page, and the bounded local correction: the formulas of
-// creaturegen's surface/deform.py (LBS, dual quaternion, centre of rotation; the method per vertex is
+// creaturegen's surface/skinning.py (LBS, dual quaternion, centre of rotation; the method per vertex is
 // its joint's choice, baked into the asset) and of creature/reference.py (the per-vertex correction).
 import { Fn, If, Loop, Break, abs, float, int, normalize, select, sqrt, vec3, vec4 } from 'three/tsl';
 
@@ -32,7 +32,7 @@ export function createSkin({ pose, rows, field, correction }) {
   const quat = (base, s) => pose.element(base.add(s.mul(rows)).add(3));
   const shift = (base, s) => pose.element(base.add(s.mul(rows)).add(4)).xyz;
 
-  // LBS, as the reference's skin_lbs (surface/deform.py): v + Σ wᵢ((Rᵢ − I)v + tᵢ), which returns the rest vertex bit for bit at rest.
+  // LBS, as the reference's skin_lbs (surface/skinning.py): v + Σ wᵢ((Rᵢ − I)v + tᵢ), which returns the rest vertex bit for bit at rest.
   const lbs = (v, base, slots, weights) => {
     const acc = vec3(0).toVar();
     for (let c = 0; c < 4; c++) {
@@ -111,7 +111,7 @@ export function createSkin({ pose, rows, field, correction }) {
 
   /**
    * The skinned position and the skinned rest normal `n` of one vertex (a vertex that evaluates no field),
-   * each method's normal from the same blend its position uses (deform.py skin_lbs, skin_dq, skin_cor).
+   * each method's normal from the same blend its position uses (skinning.py skin_lbs, skin_dq, skin_cor).
    * Inline (call it inside a Fn): returns { position, normal } nodes.
    */
   const skinVertexNormal = (v, n, base, slots, weights, method, centre) => {

@@ -1,0 +1,34 @@
+"""Exit codes of the ``creaturegen`` command line and its error lines, shared by every command.
+
+Exit codes: 0 success, 1 a parity gate failed, 2 invalid input (bad spec, bad arguments), 3 a valid spec
+that a build gate refuses (a surface gate, a grid too fine, a deformation sweep, or fewer than N identities
+of ``--population N`` passing). Nothing is written with 2 or 3. The two are kept apart because they call
+for different fixes: 2 means the spec or the command line is wrong as written; 3 means the spec is well
+formed but its geometry cannot be certified, so the creature's shape (not its syntax) has to change.
+"""
+
+from __future__ import annotations
+
+import re
+import sys
+
+from .spec import SpecError
+
+EXIT_OK = 0
+EXIT_GATE_FAILED = 1
+EXIT_INVALID = 2
+EXIT_REFUSED = 3
+
+_LINE_COLUMN = re.compile(r"^\d+:\d+$")
+
+
+def format_error(source: str, error: SpecError) -> str:
+    """``file: part.body.r: message``, or compiler style ``file:3:14: message`` for JSON syntax."""
+    if _LINE_COLUMN.match(error.path):
+        return f"{source}:{error.path}: {error.message}"
+    return f"{source}: {error.path}: {error.message}"
+
+
+def print_errors(source: str, errors: list[SpecError]) -> None:
+    for error in errors:
+        print(format_error(source, error), file=sys.stderr)

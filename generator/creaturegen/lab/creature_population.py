@@ -1,0 +1,156 @@
+"""Parity gates on many bodies: no GPU pipelines and no buffers created by a burst of spawns that fills
+the lab's first pose page and opens its second, one instanced draw per page and pass, and one tick and
+frame of them all after reveal; and the genetics grid: 64 individuals (seeds 0..63) spawned in an 8×8 grid
+and stepped, every one's GPU pose rows (its OKLab-mutated colours and the pose its size and gait genes
+give) vs its Python reference, no two individuals alike; parity/grid.png shows them.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+from playwright.sync_api import Page
+
+from ..creature import reference as cref
+from ..creature.pose import POSE_ROWS, pose_rows, root_rows
+from ..model import layout as col
+from ..model.genome import slot_lab
+from .creature_lab import rgba_image
+from .png import write_png
+from .report import ParityReport
+
+#: Bodies per pose page in the parity lab, and the spawn burst after reveal: instance 0 plus PAGE_SIZE
+#: spawns fill page 0 and put one body on page 1, so the burst crosses a page boundary and the frame draws
+#: two pages. Small on purpose: the one frame deforms every spawned body in software (SwiftShader took
+#: 65 s for 51 beetles of 65,410 vertices), and a bigger page adds nothing the gates could see.
+PAGE_SIZE = 8
+SPAWNS = PAGE_SIZE
+#: Pages the burst's bodies occupy. The lab holds one page more unless the genetics grid runs (its GRID_SIDE²
+#: bodies need more): with exactly two pages the pages-in-use gate could not fail, since nine bodies need
+#: both; a third page lets a spawn that spreads bodies over pages show (the preload warms every page, one
+#: body each, so capacity costs time).
+PAGES_IN_BURST = 2
+SPARE_PAGES = 1
+#: The genetics grid: side, first seed, spacing (body lengths) and the tick it is compared at.
+GRID_SIDE = 8
+GRID_SEED = 0
+GRID_SPACING = 2.0
+GRID_TICK = 24
+#: Genome colours in the GPU rows vs Python: both round the same float64 value to float32, so exactly 0.
+COLOUR_TOL = 0.0
+
+
+def counter_gates(page: Page, report: ParityReport) -> None:
+    page.evaluate("() => window.__lab.resetCounters()")
+    # Spawn without drawing, then one tick and one frame of all of them: a pipeline built at draw time
+    # would show up here too.
+    page.evaluate(f"() => window.__lab.spawn(1000, {SPAWNS}, 1.5, false)")
+    page.evaluate("() => window.__lab.stepTicks(1)")
+    page.evaluate("() => window.__lab.finish()")
+    after = page.evaluate("() => window.__lab.counters()")["sinceReveal"]
+    pipelines = after["createRenderPipeline"] + after["createRenderPipelineAsync"]
+    pipelines += after["createComputePipeline"] + after["createComputePipelineAsync"]
+    report.gate(f"pipelines created by {SPAWNS} spawns after reveal", pipelines, 0, "pipelines")
+    report.gate(f"buffers created by {SPAWNS} spawns after reveal", after["createBuffer"], 0, "buffers")
+    telemetry = page.evaluate("() => window.__lab.telemetry()")
+    drawn = page.evaluate("() => window.__lab.draws()")
+    body_passes = [n for n in drawn["perPass"] if n > 0]
+    pages = telemetry["pagesInUse"]
+    report.gate(
+        f"pose pages in use after {SPAWNS} spawns of pageSize {PAGE_SIZE}",
+        pages,
+        PAGES_IN_BURST,
+        "pages",
+        passed=pages == PAGES_IN_BURST,
+    )
+    # One instanced draw per page and pass, never one per body. A pass may draw fewer: it culls a page
+    # whose bodies lie outside its frustum (the shadow camera covers body 0 only, and the burst's body on
+    # page 1 stands 1.5 L away).
+    report.gate(
+        "body draw calls in a render pass beyond pages in use (encoder count)",
+        float(max((n - pages for n in body_passes), default=pages)),
+        0,
+        "draws",
+    )
+    report.gate(
+        "render passes drawing the bodies (display + shadow)",
+        len(body_passes),
+        2,
+        "passes",
+        passed=len(body_passes) >= 2,
+    )
+    report.measurements["population"] = {
+        "count": telemetry["count"],
+        "pagesInUse": pages,
+        "pages": telemetry["pages"],
+        "drawsPerPass": drawn["perPass"],
+        "lastFrameBytes": telemetry["stats"]["lastFrameBytes"],
+        "spawnCost": page.evaluate("() => window.__lab.spawnCost()"),
+        "sinceReveal": after,
+    }
+    page.evaluate("() => window.__lab.despawnAll([0])")
+
+
+def grid_gates(page: Page, ref: cref.PackageReference, package: Path, report: ParityReport) -> None:
+    """The genetics grid: each individual's GPU pose rows against the Python reference spawned from the same
+    seed and position (the colour rows alone at float32 rounding, all rows relative to L), and how far the
+    individuals differ: colour (OKLab distance of the mean slot colour to the authored one), speed (pace gene
+    and √size together) and size."""
+    # Not drawn at spawn: the step's one upload and deform pre-pass draws all 64.
+    bodies = page.evaluate(f"() => window.__lab.grid({GRID_SIDE}, {GRID_SEED}, {GRID_SPACING}, false)")
+    page.evaluate(f"() => window.__lab.stepTicks({GRID_TICK})")
+    scale = ref.rig.body_scale
+    slots = ref.rig.slot_count
+    worst_rows = worst_colour = 0.0
+    colours, speeds, sizes = [], [], []
+    for body in bodies:
+        gpu = np.asarray(page.evaluate(f"() => window.__lab.readPose({body['id']})"), dtype=np.float32)
+        seed = int(body["seed"])
+        x, y, z = (float(c) for c in body["position"])
+        motion = cref.instance_motion(ref, seed, GRID_TICK, (x, y, z))
+        mine = cref.instance_colours(ref, seed)
+        rows = np.concatenate(
+            [
+                pose_rows(ref.rig, motion.quats, motion.trans, mine, motion.size).reshape(-1),
+                root_rows(motion.root, size=motion.size).reshape(-1),
+            ]
+        )
+        got = gpu[: rows.size]
+        worst_rows = max(worst_rows, float(np.abs(got - rows).max()) / scale)
+        colour_rows = got[: slots * POSE_ROWS * 4].reshape(slots, POSE_ROWS, 4)[:, 2, 1:4]
+        worst_colour = max(worst_colour, float(np.abs(colour_rows - np.asarray(mine, np.float32)).max()))
+        colours.append(colour_rows.astype(np.float64).ravel())
+        speeds.append(motion.data["speed"] / ref.motion["speed"] if ref.motion["speed"] > 0 else 1.0)
+        sizes.append(motion.size)
+    report.gate(
+        f"genome colours of {len(bodies)} individuals: GPU pose rows vs Python (OKLab mutation)",
+        worst_colour,
+        COLOUR_TOL,
+        "linear rgb",
+    )
+    report.gate(
+        f"pose rows of {len(bodies)} individuals at tick {GRID_TICK}: GPU vs Python (size and gait genes)",
+        worst_rows,
+        1e-6,
+        "L",
+    )
+    flat = np.asarray(colours)
+    gaps = np.linalg.norm(flat[:, None, :] - flat[None, :, :], axis=2)[np.triu_indices(len(flat), 1)]
+    genetics = ref.spec.genetics
+    if genetics.hue or genetics.chroma or genetics.lightness:
+        identical = int(np.count_nonzero(gaps == 0.0))
+        report.gate("individuals with identical colours in the grid", identical, 0, "pairs")
+    # How far the individuals stray: OKLab distance of each slot colour from the authored one.
+    authored = np.asarray(slot_lab(ref.rig.slots[:, col.RGB]))
+    shift = np.linalg.norm(np.asarray([slot_lab(c.reshape(-1, 3)) for c in flat]) - authored, axis=2)
+    report.measurements["grid"] = {
+        "bodies": len(bodies),
+        "tick": GRID_TICK,
+        "minColourGapLinear": float(gaps.min()),
+        "oklabShift": {"median": float(np.median(shift)), "max": float(shift.max())},
+        "speedRatio": [float(min(speeds)), float(max(speeds))],
+        "size": [float(min(sizes)), float(max(sizes))],
+    }
+    shot = page.evaluate("() => window.__lab.capturePixels('grid')")
+    write_png(package / "parity" / "grid.png", rgba_image(shot))
