@@ -84,3 +84,37 @@ def test_the_check_sees_imports_at_all() -> None:
     tree = ast.parse("def f():\n    from ..surface import build\n")  # surface/build.py exists
     assert "creaturegen.surface" in _imports("creaturegen.model.x", tree, False)
     assert "creaturegen.creature.reference" in code_closure("creaturegen.lab.creature_parity")
+
+
+#: Issue 26's size limits: a module does one job and a function fits on a screen.
+MODULE_MAX_LINES = 600
+FUNCTION_MAX_LINES = 80
+
+
+def _oversized(name: str, source: str) -> list[str]:
+    """The module itself if it is over MODULE_MAX_LINES, and every function over FUNCTION_MAX_LINES."""
+    found = (
+        [f"{name}: {len(source.splitlines())} lines"] if len(source.splitlines()) > MODULE_MAX_LINES else []
+    )
+    for node in ast.walk(ast.parse(source)):
+        if isinstance(node, ast.FunctionDef | ast.AsyncFunctionDef):
+            length = (node.end_lineno or node.lineno) - node.lineno + 1
+            if length > FUNCTION_MAX_LINES:
+                found.append(f"{name}.{node.name}: {length} lines")
+    return found
+
+
+def test_no_module_over_600_lines_and_no_function_over_80() -> None:
+    found = [
+        row
+        for path in sorted(PACKAGE_ROOT.rglob("*.py"))
+        for row in _oversized(str(path.relative_to(PACKAGE_ROOT)), path.read_text(encoding="utf-8"))
+    ]
+    assert not found, found
+
+
+def test_the_size_check_sees_a_long_function_and_a_long_module() -> None:
+    body = "".join(f"    x{i} = {i}\n" for i in range(FUNCTION_MAX_LINES))
+    assert _oversized("m", f"def f():\n{body}") == ["m.f: 81 lines"]
+    assert _oversized("m", "x = 1\n" * (MODULE_MAX_LINES + 1)) == ["m: 601 lines"]
+    assert _oversized("m", f"def f():\n{body[: body.rindex('    x')]}") == []
