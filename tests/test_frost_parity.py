@@ -114,7 +114,7 @@ def test_parity_job_catches_a_wrong_catch_up_of_late_segments(built: dict[str, P
     source = built["default"]
     broken = tmp_path / source.name
     shutil.copytree(source, broken)
-    effect = broken / "tsl" / "frost-effect.js"
+    effect = broken / "tsl" / "kernels.js"
     text = effect.read_text()
     exact = "return exp(rb.negate().mul(tau)).mul(x).add("
     assert exact in text
@@ -134,10 +134,10 @@ def test_parity_job_catches_a_debug_view_switch_that_does_nothing(
     source = built["frost-budgeted"]
     broken = tmp_path / source.name
     shutil.copytree(source, broken)
-    effect = broken / "tsl" / "frost-effect.js"
+    effect = broken / "tsl" / "controls.js"
     text = effect.read_text()
-    assert "    uDebugView.value = index;\n" in text
-    effect.write_text(text.replace("    uDebugView.value = index;\n", "    void index;\n", 1))
+    assert "  state.composite.uDebugView.value = index;\n" in text
+    effect.write_text(text.replace("  state.composite.uDebugView.value = index;\n", "  void index;\n", 1))
     result = run_frost_parity(broken, groups=("views",))
     failed = [g["name"] for g in result.gates if g["status"] == "fail"]
     assert any(name.startswith("debug views identical to the final view") for name in failed), (
@@ -214,7 +214,7 @@ def test_parity_job_holds_a_float32_history_to_its_own_tolerance(
     [
         (
             "a kernel that keeps the last stroke's coverage instead of the largest",
-            "tsl/frost-effect.js",
+            "tsl/kernels.js",
             ("br.assign(max(br, info.x", "br.assign(max(float(0), info.x"),
             "GPU vs numpy history, 8 strokes at once",
         ),
@@ -229,7 +229,7 @@ def test_parity_job_holds_a_float32_history_to_its_own_tolerance(
         ),
         (
             "a kernel that forgets the decay of the steps its bin skips",
-            "tsl/frost-effect.js",
+            "tsl/kernels.js",
             ("xr.mulAssign(exp(float(-vis.decay).mul(s.z.sub(elapsed))));", ""),
             "GPU vs numpy history, 8 strokes at once",
         ),
