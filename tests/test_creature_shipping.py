@@ -466,9 +466,13 @@ def test_creature_data_is_typed_field_for_field(hopper: Path) -> None:
         assert isinstance(spec, CharacterSpec)
         rig = compile_rig(spec)
         motion = build_motion(spec, rig, build_skeleton(spec, rig))
-        shapes["MotionData"] |= set(motion)
+        shipped = motion.to_json()
+        shapes["MotionData"] |= set(shipped)
         for field, interface in (("legs", "LegData"), ("ropes", "RopeData"), ("wings", "WingData")):
-            for item in motion[field]:
+            items = shipped[field]
+            assert isinstance(items, list)
+            for item in items:
+                assert isinstance(item, dict)
                 shapes[interface] |= set(item)
     for interface, fields in shapes.items():
         assert fields, f"no example has {interface}"

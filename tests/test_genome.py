@@ -21,13 +21,14 @@ from creaturegen.model import layout as col
 from creaturegen.model.genome import (
     Genome,
     draw_genome,
-    express_gait,
     genetics_data,
     genome_colours,
     linear_from_oklab,
     slot_lab,
 )
 from creaturegen.model.skeleton import build_skeleton
+from creaturegen.motion.data import MotionData
+from creaturegen.motion.express import express_gait
 from creaturegen.motion.rig import build_motion
 from creaturegen.rig import compile_rig
 from creaturegen.rig.colour import hex_to_linear
@@ -105,7 +106,7 @@ def test_colour_mutation_clips_into_gamut() -> None:
         assert rgb.max() <= 1.0
 
 
-def _motion(name: str) -> dict[str, object]:
+def _motion(name: str) -> MotionData:
     spec = load_spec(EXAMPLES / name)
     assert isinstance(spec, CharacterSpec)
     rig = compile_rig(spec)
@@ -114,18 +115,18 @@ def _motion(name: str) -> dict[str, object]:
 
 def test_gait_genes_scale_pace_together_and_respect_the_reach_limit() -> None:
     data = _motion("reference/quadruped.json")
-    frozen = json.dumps(data, sort_keys=True)
-    jitter = data["genes"]["jitter"]  # type: ignore[index]
+    frozen = json.dumps(data.to_json(), sort_keys=True)
+    jitter = data.genes.jitter
     slow = express_gait(data, Genome(0.0, 0.0, 0.0, (-1.0, 0.5, 0.0)))
-    assert json.dumps(data, sort_keys=True) == frozen, "express_gait modified the authored data"
-    assert slow["speed"] / data["speed"] == pytest.approx(1.0 - jitter)  # type: ignore[operator]
-    assert slow["stepLength"] / data["stepLength"] == pytest.approx(1.0 - jitter)  # type: ignore[operator]
-    assert slow["stepHeight"] / data["stepHeight"] == pytest.approx(1.0 + 0.5 * jitter)  # type: ignore[operator]
+    assert json.dumps(data.to_json(), sort_keys=True) == frozen, "express_gait modified the authored data"
+    assert slow.speed / data.speed == pytest.approx(1.0 - jitter)
+    assert slow.step_length / data.step_length == pytest.approx(1.0 - jitter)
+    assert slow.step_height / data.step_height == pytest.approx(1.0 + 0.5 * jitter)
     # The quadruped's step length sits at its reach limit: a faster pace is capped there, speed with it.
     fast = express_gait(data, Genome(0.0, 0.0, 0.0, (1.0, 0.0, 0.0)))
-    assert data["stepLength"] == data["stepLimit"]
-    assert fast["stepLength"] == data["stepLimit"]
-    assert fast["speed"] == data["speed"]
+    assert data.step_length == data.step_limit
+    assert fast.step_length == data.step_limit
+    assert fast.speed == data.speed
 
 
 def test_a_zero_gait_bound_keeps_every_individual_on_the_authored_gait() -> None:
@@ -237,7 +238,7 @@ def _numbers(value: object) -> list[float]:
 def test_motion_data_survives_a_json_round_trip_exactly(name: str) -> None:
     """core/genome.js express copies an individual's motion data through JSON (V8's fast layouts, so the
     step allocates nothing): exact only if no number is -0 or non-finite, which build_motion ensures."""
-    data = _motion(name)
+    data = _motion(name).to_json()
     numbers = _numbers(data)
     assert numbers
     assert all(math.isfinite(x) for x in numbers), f"{name}: a non-finite number in the motion data"

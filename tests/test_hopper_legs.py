@@ -13,6 +13,7 @@ import pytest
 
 from creaturegen.model.skeleton import build_skeleton
 from creaturegen.motion import quat as vq
+from creaturegen.motion.data import LegData, MotionData
 from creaturegen.motion.gait import home
 from creaturegen.motion.hop import hop_at
 from creaturegen.motion.providers import builtin_supports, to_local, to_world
@@ -37,7 +38,7 @@ def _document(legs: int) -> dict[str, Any]:
     return document
 
 
-def _motion_data(document: dict[str, Any]) -> dict[str, Any]:
+def _motion_data(document: dict[str, Any]) -> MotionData:
     spec = validate_bytes(json.dumps(document).encode())
     assert isinstance(spec, CharacterSpec)
     rig = compile_rig(spec)
@@ -80,14 +81,14 @@ def test_the_kangaroo_is_a_hopper_on_two_hind_legs_under_the_rear_of_its_body() 
     assert any(p.shape == "rope" and p.parent == "body" for p in spec.parts), "a tail"
 
 
-def _drawn(motion: Motion, leg: dict[str, Any]) -> tuple[list[float], list[float], list[float]]:
+def _drawn(motion: Motion, leg: LegData) -> tuple[list[float], list[float], list[float]]:
     """Hip, knee and foot of ``leg`` as its slot transforms draw them (creature frame)."""
 
-    def moved(slot: int, x: list[float]) -> list[float]:
+    def moved(slot: int, x: vq.Point) -> list[float]:
         r = vq.rotate(motion.quats[slot], x)
         return [r[k] + motion.trans[slot][k] for k in range(3)]
 
-    return moved(leg["upper"], leg["hip"]), moved(leg["upper"], leg["knee"]), moved(leg["lower"], leg["foot"])
+    return moved(leg.upper, leg.hip), moved(leg.upper, leg.knee), moved(leg.lower, leg.foot)
 
 
 def _knee_deg(hip: list[float], knee: list[float], foot: list[float]) -> float:
@@ -124,19 +125,19 @@ def test_the_kangaroos_feet_stay_planted_on_the_ground_and_leave_it_in_the_air(s
         phase = _phase(motion, n)
         frame = motion.support.frame(n * d.dt)
         # The individual's legs (seed 7's size gene scales the authored ones).
-        for leg, foot in zip(motion.data["legs"], motion.feet, strict=True):
+        for leg, foot in zip(motion.data.legs, motion.feet, strict=True):
             hip, knee, drawn = _drawn(motion, leg)
-            span = leg["a"] + leg["b"]
+            span = leg.a + leg.b
             at = to_local(frame, to_world_root(motion.root, drawn))
             knees.setdefault(phase, []).append(_knee_deg(hip, knee, drawn))
             if phase != "air":
-                assert foot.planted, f"{support} tick {n} ({phase}): foot of {leg['part']} lifted"
+                assert foot.planted, f"{support} tick {n} ({phase}): foot of {leg.part} lifted"
                 target = to_local_root(motion.root, to_world(frame, foot.p))
-                reach = vq.distance(target, leg["hip"])
-                assert leg["reachMin"] < reach < leg["reachMax"], f"{support} tick {n}: IK clamped"
+                reach = vq.distance(target, leg.hip)
+                assert leg.reach_min < reach < leg.reach_max, f"{support} tick {n}: IK clamped"
                 drift = max(drift, vq.distance(at, foot.p) / span)
             else:
-                assert not foot.planted, f"{support} tick {n}: foot of {leg['part']} planted in the air"
+                assert not foot.planted, f"{support} tick {n}: foot of {leg.part} planted in the air"
                 if n == foot.n0:
                     assert vq.distance(at, foot.s) / span <= 1e-12
                     planted_air += 1
@@ -176,11 +177,11 @@ def test_the_landing_plant_is_where_the_hop_lands(support: str) -> None:
             motion.step_ticks(d.air)
             assert _phase(motion, motion.tick) == "land"
             frame = motion.support.frame(motion.tick * d.dt)
-            for leg, foot, where, was in zip(motion.data["legs"], motion.feet, aimed, start, strict=True):
+            for leg, foot, where, was in zip(motion.data.legs, motion.feet, aimed, start, strict=True):
                 assert foot.planted
                 assert foot.p == where
                 assert foot.p == home(leg, frame, motion.root)
-                assert 0.9 < math.dist(was, where) / motion.data["hopLength"] < 1.1
+                assert 0.9 < math.dist(was, where) / motion.data.hop_length < 1.1
             hops += 1
 
 

@@ -9,6 +9,7 @@ import json
 import math
 import re
 import subprocess
+from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
@@ -23,8 +24,10 @@ from conftest import (
     run_node_tests,
     spec_file,
 )
+from creaturegen.model.record import field_value
 from creaturegen.model.skeleton import build_skeleton
 from creaturegen.motion import quat as vq
+from creaturegen.motion.data import MotionData
 from creaturegen.motion.envelope import corner_genomes
 from creaturegen.motion.parity import motion_reference
 from creaturegen.motion.providers import (
@@ -50,26 +53,26 @@ TICKS = 1000
 MOTION_SPECS = [*CREATURE_EXAMPLES, *MOTION_FIXTURES]
 
 
-def motion_data(name: str) -> dict[str, Any]:
+def motion_data(name: str) -> MotionData:
     spec = load_spec(spec_file(name))
     rig = compile_rig(spec)
     return build_motion(spec, rig, build_skeleton(spec, rig))
 
 
-def run(data: dict[str, Any], support: str, ticks: int = TICKS) -> Motion:
+def run(data: MotionData, support: str, ticks: int = TICKS) -> Motion:
     motion = Motion(data, support=builtin_supports()[support], water=AnalyticWater(), seed=7)
     motion.step_ticks(ticks)
     return motion
 
 
-def assert_gates(where: str, g: Gates, data: dict[str, Any], ticks: int) -> None:
+def assert_gates(where: str, g: Gates, data: MotionData, ticks: int) -> None:
     """Every locomotion gate of one run (``ticks`` fixed steps); prints the worst values."""
-    kind = data["type"]
+    kind = data.type
     print(
         f"{where}: drift {g.plant_drift:.2e} ik {g.ik_residual:.2e} drawn {g.drawn_foot:.2e} "
         f"clamped {g.clamped_ticks} steps {g.steps} rope {g.rope_anchor:.2e} swim {g.swim_tracking:.4f}m "
         f"apex {g.apex_error:.2e} m squash@apex {g.apex_squash!r} both-swing {g.both_swing_ticks} "
-        f"fewest planted {g.fewest_planted} of {len(data['legs'])}"
+        f"fewest planted {g.fewest_planted} of {len(data.legs)}"
     )
     assert g.plant_drift <= 1e-9, f"{where}: planted-foot drift {g.plant_drift:.3g} x leg length"
     assert g.ik_residual <= 1e-12, f"{where}: IK length residual {g.ik_residual:.3g}"
@@ -78,10 +81,10 @@ def assert_gates(where: str, g: Gates, data: dict[str, Any], ticks: int) -> None
     if kind in WALKERS:
         assert g.steps > 0, f"{where}: no foot ever stepped"
         assert g.planted_samples > 0
-        assert g.clamped_ticks <= 0.01 * len(data["legs"]) * ticks, f"{where}: {g.clamped_ticks} clamped"
+        assert g.clamped_ticks <= 0.01 * len(data.legs) * ticks, f"{where}: {g.clamped_ticks} clamped"
         # One phase group swings at a time: with alternating groups half the feet are always down (the
         # biped one, a trotting quadruped two, tripods three, the spider's tetrapods four).
-        half = len(data["legs"]) // 2
+        half = len(data.legs) // 2
         assert g.fewest_planted >= half, f"{where}: only {g.fewest_planted} feet planted on some tick"
     if kind == "biped":
         assert g.both_swing_ticks == 0, f"{where}: both feet in swing on {g.both_swing_ticks} ticks"
@@ -89,7 +92,7 @@ def assert_gates(where: str, g: Gates, data: dict[str, Any], ticks: int) -> None
         assert g.apex_error <= 1e-9, f"{where}: hop apex height error {g.apex_error:.3g} m"
         assert g.apex_squash == 1.0, f"{where}: squash at the apex tick is {g.apex_squash!r}"
         assert g.squash_det <= 4e-16, f"{where}: squash determinant off by {g.squash_det:.3g}"
-        if data["legs"]:
+        if data.legs:
             # Its legs take off with every hop and are planted (and drift-gated) between hops.
             assert g.steps > 0, f"{where}: the legs never left the ground"
             assert g.planted_samples > 0, f"{where}: no planted foot was measured"
@@ -115,15 +118,17 @@ def test_gates_hold_at_the_corners_of_the_gene_box(name: str) -> None:
     alone, failed here (a foot lagging past its reach before its window opened); the pace gene scales them
     together."""
     data = motion_data(name)
-    assert data["genes"]["jitter"] > 0.0
-    assert data["genes"]["size"] > 0.0
+    assert data.genes.jitter > 0.0
+    assert data.genes.size > 0.0
     corners = corner_genomes(data)[1:]
-    assert len(corners) == 2 ** (len(data["genes"]["fields"]) + 1)
+    assert len(corners) == 2 ** (len(data.genes.fields) + 1)
     for label, genome in corners:
         motion = Motion(data, water=AnalyticWater(), genome=genome)
-        fields = [f for group in data["genes"]["fields"] for f in group]
-        assert any(motion.data[f] != data[f] for f in fields), f"{name}: {label} changed nothing"
-        assert motion.size == 1.0 + data["genes"]["size"] * genome.size
+        fields = [f for group in data.genes.fields for f in group]
+        assert any(field_value(motion.data, f) != field_value(data, f) for f in fields), (
+            f"{name}: {label} changed nothing"
+        )
+        assert motion.size == 1.0 + data.genes.size * genome.size
         motion.step_ticks(CORNER_TICKS)
         assert_gates(f"{name} {label}", motion.gates, motion.data, CORNER_TICKS)
 
@@ -166,7 +171,7 @@ def test_hop_air_time_is_physical_and_quantised() -> None:
     assert d.air == 2 * d.half_air, "the apex is sampled exactly at a tick"
     air_s = d.air * d.dt
     # The individual's hop height (its gait gene scaled the authored one).
-    ideal = 2.0 * (2.0 * motion.data["hopHeight"] / d.g) ** 0.5
+    ideal = 2.0 * (2.0 * motion.data.hop_height / d.g) ** 0.5
     assert abs(air_s - ideal) <= d.dt, (air_s, ideal)
     assert abs(d.apex - 0.5 * d.g * (d.half_air * d.dt) ** 2) < 1e-15
 
@@ -202,10 +207,10 @@ def test_a_swimmer_without_a_required_channel_is_refused() -> None:
         Motion(data)
 
 
-ROPE_EXAMPLES = [n for n in CREATURE_EXAMPLES if motion_data(n)["ropes"]]
+ROPE_EXAMPLES = [n for n in CREATURE_EXAMPLES if motion_data(n).ropes]
 #: Settling needs a body that holds still at speed 0; the hopper's hop cycle does not depend on speed, so
 #: its rope is driven for ever (its ratio is printed, not gated).
-SETTLING = [n for n in ROPE_EXAMPLES if motion_data(n)["type"] != "hopper"]
+SETTLING = [n for n in ROPE_EXAMPLES if motion_data(n).type != "hopper"]
 
 
 def _rope_local(motion: Motion) -> list[list[float]]:
@@ -216,9 +221,9 @@ def _rope_local(motion: Motion) -> list[list[float]]:
 def test_ropes_settle_when_the_body_holds_still(name: str) -> None:
     """The lessons' gate: a rope released from its rest pose on a body standing still (speed 0) moves at
     4 s at less than 0.2 of its speed at 0.5 s (mean node speed relative to the body)."""
-    data = {**motion_data(name), "speed": 0.0}
+    data = replace(motion_data(name), speed=0.0)
     motion = Motion(data, water=AnalyticWater(), seed=1)
-    hz, speeds = data["hz"], {}
+    hz, speeds = data.hz, {}
     prev = _rope_local(motion)
     for n in range(1, 4 * hz + 1):
         motion.step()
@@ -243,20 +248,20 @@ def test_ropes_bend_without_folding_and_stay_above_the_ground(name: str) -> None
         for _ in range(TICKS):
             motion.step()
             frame = motion.support.frame(motion.tick * motion.d.dt)
-            for rope, nodes in zip(data["ropes"], motion.nodes, strict=True):
+            for rope, nodes in zip(data.ropes, motion.nodes, strict=True):
                 dirs = [[b[k] - a[k] for k in range(3)] for a, b in itertools.pairwise(nodes)]
                 for u, v in itertools.pairwise(dirs):
                     worst_cos = min(
                         worst_cos,
                         sum(x * y for x, y in zip(u, v, strict=True)) / math.hypot(*u) / math.hypot(*v),
                     )
-                for r, x in zip(rope["radius"][1:], nodes[1:], strict=True):
+                for r, x in zip(rope.radius[1:], nodes[1:], strict=True):
                     lowest = min(lowest, to_local(frame, x)[1] - r)
         bend = math.degrees(math.acos(worst_cos))
         print(f"{name} {support}: worst bend {bend:.1f} deg, lowest node clearance {lowest:.3g} m")
         assert bend < 90.0, f"{name} on {support}: a rope folds by {bend:.1f} deg"
-        if data["ropeGround"]:
-            assert lowest >= -1e-12 * data["bodyScale"], (
+        if data.rope_ground:
+            assert lowest >= -1e-12 * data.body_scale, (
                 f"{name} on {support}: a rope node sinks {-lowest:.3g} m"
             )
 
@@ -275,7 +280,7 @@ def test_no_slot_turns_by_a_flip_between_ticks(name: str) -> None:
     # Each slot's rest axis (a sphere has none: its whole turn is gated instead).
     ends = [[b - a for a, b in zip(row[0:3], row[4:7], strict=True)] for row in rig.slots.tolist()]
     axes = [vq.normalize(e) if vq.length(e) > 0.0 else [0.0, 0.0, 0.0] for e in ends]
-    ropes = {s for rope in data["ropes"] for s in rope["slots"]}
+    ropes = {s for rope in data.ropes for s in rope.slots}
     motion = Motion(data, support=RotatingPlatform(), water=AnalyticWater(), seed=7)
     twist = turn = swing = (0.0, 0, 0)
     prev = [list(q) for q in motion.quats]
@@ -302,7 +307,7 @@ def test_no_slot_turns_by_a_flip_between_ticks(name: str) -> None:
     assert turn[0] < 60.0, f"{name}: slot {turn[2]} turns {turn[0]:.1f} deg at tick {turn[1]}"
 
 
-def _walker_spider(legs: int) -> dict[str, Any]:
+def _walker_spider(legs: int) -> MotionData:
     """Motion data of the spider as a ``walker`` with its front ``legs`` legs (pairs front to back)."""
     document = json.loads(spec_file("fixtures/spider.json").read_text())
     kept = [p["id"] for p in document["parts"] if p["shape"] == "leg"][:legs]
@@ -319,9 +324,9 @@ def test_walkers_with_every_even_leg_count_keep_the_gates(legs: int) -> None:
     """The generic walker on 2, 4, 6 and 8 of the spider's legs, on every support: the same gates as the
     named walkers, half its feet always planted."""
     data = _walker_spider(legs)
-    assert data["type"] == "walker"
-    assert len(data["legs"]) == legs
-    assert data["groups"] == 2
+    assert data.type == "walker"
+    assert len(data.legs) == legs
+    assert data.groups == 2
     for support in builtin_supports():
         gates = run(data, support).gates
         assert_gates(f"walker on {legs} legs, {support}", gates, data, TICKS)
@@ -331,18 +336,18 @@ def test_walkers_with_every_even_leg_count_keep_the_gates(legs: int) -> None:
 def test_a_single_phase_group_lifts_every_foot_at_once() -> None:
     """Why the gate is there: the gait lifts one phase group at a time, so a walker whose legs all share a
     phase has every foot in the air at once (the spec does not forbid it; the gate shows it)."""
-    data = motion_data("fixtures/spider.json")
-    for leg in data["legs"]:
-        leg["group"] = 0
-    data["groups"] = 1
+    spider = motion_data("fixtures/spider.json")
+    data = replace(spider, legs=tuple(replace(leg, group=0) for leg in spider.legs), groups=1)
     assert run(data, "flat", 300).gates.fewest_planted == 0
 
 
 def test_the_gates_can_fail() -> None:
     """A shin drawn 1 cm shorter than the IK solves for: the drawn foot leaves its plant, and both the
     drawn-foot and the planted-drift gates see it."""
-    data = motion_data("reference/biped.json")
-    data["legs"][0]["foot"][1] += 0.01
+    biped = motion_data("reference/biped.json")
+    first = biped.legs[0]
+    x, y, z = first.foot
+    data = replace(biped, legs=(replace(first, foot=(x, y + 0.01, z)), *biped.legs[1:]))
     g = run(data, "flat", 200).gates
     assert g.drawn_foot > 1e-3
     assert g.plant_drift > 1e-3
@@ -352,7 +357,7 @@ def test_the_gates_can_fail() -> None:
 def test_js_core_matches_python(name: str, creature_out: Path, tmp_path: Path) -> None:
     package = build_example(name, creature_out)
     data = motion_data(name)
-    reference = {**motion_reference(data), "data": data}
+    reference = {**motion_reference(data), "data": data.to_json()}
     path = tmp_path / "motion-reference.json"
     path.write_text(json.dumps(reference))
     env = {"MOTION_CORE": str(package / "core" / "index.js"), "MOTION_REFERENCE": str(path)}
@@ -367,8 +372,8 @@ def test_js_core_matches_python_for_the_generic_walker_type(creature_out: Path, 
     with the type relabelled (a module re-exporting the core) is what a walker spider builds; the JS core
     must still take it for a walker and match Python bit for bit."""
     package = build_example("fixtures/spider.json", creature_out)
-    data = {**motion_data("fixtures/spider.json"), "type": "walker"}
-    reference = {**motion_reference(data), "data": data}
+    data = replace(motion_data("fixtures/spider.json"), type="walker")
+    reference = {**motion_reference(data), "data": data.to_json()}
     path = tmp_path / "motion-reference.json"
     path.write_text(json.dumps(reference))
     relabelled = wrapped_core(

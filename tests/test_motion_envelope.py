@@ -12,12 +12,13 @@ import pytest
 
 from conftest import CREATURE_EXAMPLES, MOTION_FIXTURES, spec_file
 from creaturegen.model import layout as col
-from creaturegen.model.skeleton import build_skeleton
+from creaturegen.model.skeleton import Skeleton, build_skeleton
 from creaturegen.motion import envelope
+from creaturegen.motion.data import MotionData
 from creaturegen.motion.providers import AnalyticWater
 from creaturegen.motion.rig import ROPE_BEND_LIMIT_DEG, build_motion
 from creaturegen.motion.simulate import Motion
-from creaturegen.rig import compile_rig
+from creaturegen.rig import CompiledRig, compile_rig
 from creaturegen.spec import CharacterSpec
 from creaturegen.spec.gate import load_spec
 
@@ -25,7 +26,7 @@ from creaturegen.spec.gate import load_spec
 RANDOM_SEEDS = (101, 2024, 77777)
 
 
-def _load(name: str) -> tuple[CharacterSpec, object, dict, object]:
+def _load(name: str) -> tuple[CharacterSpec, CompiledRig, MotionData, Skeleton]:
     spec = load_spec(spec_file(name))
     assert isinstance(spec, CharacterSpec)
     rig = compile_rig(spec)
@@ -72,11 +73,11 @@ def test_rigid_body_motion_is_taken_out_and_a_flap_moves_its_wing_by_its_chord()
     flap cycle reaches it."""
     spec, rig, data, _ = _load("reference/flyer.json")
     env = envelope.pose_envelope(spec, rig)
-    root = data["roots"][0]
+    root = data.roots[0]
     assert env.slot_displacement[root] <= 1e-12
-    for wing in data["wings"]:
-        slot = wing["slot"]
-        chord = 2.0 * wing["length"] * math.sin(wing["amplitude"] / 2.0)
+    for wing in data.wings:
+        slot = wing.slot
+        chord = 2.0 * wing.length * math.sin(wing.amplitude / 2.0)
         assert 0.98 * chord <= env.slot_displacement[slot] <= chord * (1.0 + 1e-12), (slot, chord)
     assert any(j.bend_deg > 0.0 for j in env.joints)
     assert all(j.pivot_drift < 1e-12 for j in env.joints), "a wing turns about its root"
@@ -91,8 +92,8 @@ def test_ropes_keep_their_length_and_bend_limit() -> None:
     worst_len, worst_bend = 0.0, 0.0
     for _ in range(600):
         motion.step()
-        for rope, nodes in zip(motion.data["ropes"], motion.nodes, strict=True):  # the individual's size
-            seg = rope["segment"]
+        for rope, nodes in zip(motion.data.ropes, motion.nodes, strict=True):  # the individual's size
+            seg = rope.segment
             dirs = [np.subtract(b, a) for a, b in itertools.pairwise(nodes)]
             worst_len = max(worst_len, max(abs(float(np.linalg.norm(d)) - seg) / seg for d in dirs))
             for u, v in itertools.pairwise(dirs):
@@ -120,7 +121,7 @@ def test_the_disk_copy_is_the_measured_envelope_bit_for_bit() -> None:
         assert np.array_equal(a.translations, b.translations)
     # The hopper's squash is the root transform's, applied after the field: it moves no slot, so the body
     # slot (a root) stays put while the tail swings.
-    assert env.slot_displacement[data["roots"][0]] == 0.0
+    assert env.slot_displacement[data.roots[0]] == 0.0
     tail = [s for s, part in enumerate(rig.slot_parts) if part == "counter-tail"]
     assert np.all(env.slot_displacement[tail] > 0.0)
     assert rig.slots[tail[0], col.RA] > 0.0

@@ -19,8 +19,9 @@ from conftest import build_example
 from creaturegen.creature import reference as cref
 from creaturegen.creature.pose import as_pose, pose_rows
 from creaturegen.lab.creature_lab import LAB_SEED, PARITY_TICK
-from creaturegen.model.genome import draw_genome, individual_size
+from creaturegen.model.genome import draw_genome
 from creaturegen.model.rotations import Pose
+from creaturegen.motion.express import individual_size
 from creaturegen.motion.providers import AnalyticWater
 from creaturegen.motion.simulate import Motion
 
@@ -42,7 +43,7 @@ def _triangle_normals(points: np.ndarray, faces: np.ndarray) -> np.ndarray:
 def test_an_individual_of_any_size_is_the_certified_body_scaled(package: Path) -> None:
     ref = cref.load_reference(package)
     scale = ref.rig.body_scale
-    genes = ref.motion["genes"]["size"]
+    genes = ref.motion.genes.size
     assert genes > 0.0
     # The unit body's pose at the parity tick (size gene 0), and the pose of the same body at size s.
     unit = Motion(

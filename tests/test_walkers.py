@@ -4,6 +4,7 @@ validate, export to the schema, and compile to the motion data of the named walk
 from __future__ import annotations
 
 import json
+from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
@@ -12,6 +13,7 @@ import pytest
 
 from conftest import REPO
 from creaturegen.model.skeleton import build_skeleton
+from creaturegen.motion.data import MotionData
 from creaturegen.motion.rig import WALKERS, build_motion
 from creaturegen.rig import compile_rig
 from creaturegen.spec import CharacterSpec, SpecValidationError, load_spec, validate_bytes
@@ -35,7 +37,7 @@ def _errors(document: dict[str, Any]) -> list[str]:
     return [str(e) for e in caught.value.errors]
 
 
-def _motion(document: dict[str, Any]) -> dict[str, Any]:
+def _motion(document: dict[str, Any]) -> MotionData:
     spec = validate_bytes(json.dumps(document).encode())
     assert isinstance(spec, CharacterSpec)
     rig = compile_rig(spec)
@@ -103,10 +105,10 @@ def test_walkers_take_the_walking_fields_only(kind: str) -> None:
 def test_a_walker_spider_compiles_to_the_octopods_motion_data_but_for_its_type() -> None:
     """What lets the JS parity test run the walker type on the octopod's package (tests/test_motion.py)."""
     octopod, walker = _motion(_spider("octopod")), _motion(_spider("walker"))
-    assert walker["type"] == "walker"
-    assert {**walker, "type": "octopod"} == octopod
-    assert octopod["genes"]["fields"] == [["speed", "stepLength"], ["stepHeight"]]
-    assert octopod["ropeGround"] is True
+    assert walker.type == "walker"
+    assert replace(walker, type="octopod") == octopod
+    assert octopod.genes.fields == (("speed", "stepLength"), ("stepHeight",))
+    assert octopod.rope_ground is True
 
 
 @pytest.mark.parametrize("kind", ["octopod", "walker"])

@@ -1,9 +1,9 @@
 """The creature build plan: every number the package's runtime needs, computed once, as plain JSON data.
 
-Templates print this plan and nothing else. ``plan["runtime"]`` becomes core/data.js; the Python
-reference (motion/simulate.py, creature/pose.py, creature/reference.py) reads the same rig, skeleton and
-tapes, which is what
-makes the lab-vs-numpy parity job meaningful.
+Templates print this plan and nothing else. ``plan["runtime"]`` (the JSON of the typed CreatureData record,
+creature/runtime.py) becomes core/data.js; the Python reference (motion/simulate.py, creature/pose.py,
+creature/reference.py) reads the same rig, skeleton, motion record and tapes, which is what makes the
+lab-vs-numpy parity job meaningful.
 """
 
 from __future__ import annotations
@@ -19,8 +19,9 @@ from ..field.floors import floors_for
 from ..field.primitives import GRADIENT_FLOOR, slot_uses_round_cone
 from ..model import layout as col
 from ..model.genome import genetics_data, slot_lab
-from ..model.lcg import LCG_A, LCG_C
+from ..model.lcg import LCG
 from ..model.skeleton import Skeleton, build_skeleton
+from ..motion.data import MotionData
 from ..motion.rig import build_motion
 from ..rig import CompiledRig
 from ..spec import CharacterSpec, slugify
@@ -31,6 +32,7 @@ from ..surface.correction_region import NO_PROGRAM, SKIN_PROGRAM
 from ..surface.skinning import METHODS
 from .assets import asset_plan
 from .pose import POSE_ROWS
+from .runtime import CorrectionData, CreatureData, MeshCounts, data_declarations
 from .tape import Tape, compile_tape
 
 #: The runtime's debug views (lab `setDebugMode`); "shell" is the diagnostic capsule shell.
@@ -44,7 +46,8 @@ THREE_RELEASE = {"revision": "185", "peer": ">=0.185.0 <0.186.0", "pin": "0.185"
 
 @dataclass(frozen=True)
 class CreaturePlan:
-    plan: dict[str, Any]
+    plan: dict[str, Any]  # what the templates print (its "runtime" is ``runtime.to_json()``)
+    runtime: CreatureData
     tapes: tuple[Tape, ...]  # candidate programs in asset order, then the full graph
     skeleton: Skeleton
 
@@ -106,18 +109,19 @@ def build_plan(
     assets = asset_plan(slug, surface.signatures["geometryDigest"])
     runtime = _runtime(spec, rig, surface, spec_sha256, skeleton, motion, tapes, note, slug, assets)
     workload = _workload(rig, surface, runtime, tapes)
+    runtime_json = runtime.to_json()
     skin = np.asarray(surface.asset.skin)  # (V, 2): method code, trust radius
     plan: dict[str, Any] = {
         "name": spec.name,
-        "slug": runtime["slug"],
+        "slug": runtime.slug,
         "version": __version__,
         "specSha256": spec_sha256,
-        "runtime": runtime,
+        "runtime": runtime_json,
         "assets": assets,
         "three": THREE_RELEASE,
         "usage": _usage(motion),
         # The package README's gait-gene line (each gene scales its fields together).
-        "genes": "; ".join(" with ".join(g) for g in motion["genes"]["fields"]) or "nothing (no locomotion)",
+        "genes": "; ".join(" with ".join(g) for g in motion.genes.fields) or "nothing (no locomotion)",
         "sizeRange": f"{1.0 - spec.genetics.size:g} to {1.0 + spec.genetics.size:g}",
         "signatures": dict(surface.signatures),
         "tier": surface.tier,
@@ -125,14 +129,16 @@ def build_plan(
         "representation": _representation(workload["fieldVertices"], surface.asset.vertex_count),
         "workload": workload,
         "methods": {m: int(np.count_nonzero(skin[:, 0] == i)) for i, m in enumerate(METHODS)},
-        # The string unions of core/index.d.ts, from the Python definitions the runtime data comes from.
+        # The string unions of core/index.d.ts, from the Python definitions the runtime data comes from,
+        # and its interfaces of that data, rendered from the records it is built as.
         "types": {
             "debugMode": list(DEBUG_MODES),
             "tierName": list(TIERS),
             "locomotionType": list(get_args(LocomotionType)),
+            "declarations": data_declarations(),
         },
     }
-    return CreaturePlan(plan, tuple(tapes), skeleton)
+    return CreaturePlan(plan, runtime, tuple(tapes), skeleton)
 
 
 def _runtime(
@@ -141,64 +147,60 @@ def _runtime(
     surface: SurfaceBuild,
     spec_sha256: str,
     skeleton: Skeleton,
-    motion: dict[str, Any],
+    motion: MotionData,
     tapes: list[Tape],
     note: str,
     slug: str,
     assets: dict[str, Any],
-) -> dict[str, Any]:
+) -> CreatureData:
     """``plan["runtime"]``: the data core/data.js holds."""
     floors = floors_for(rig.body_scale)
     asset = surface.asset
-    return {
-        "name": spec.name,
-        "slug": slug,
-        "version": __version__,
-        "specSha256": spec_sha256,
-        "signatures": dict(surface.signatures),
-        "tier": surface.tier,
+    return CreatureData(
+        name=spec.name,
+        slug=slug,
+        version=__version__,
+        spec_sha256=spec_sha256,
+        signatures=dict(surface.signatures),
+        tier=surface.tier,
         # The runtime names its .glb in errors and resolves it against `assetBase`.
-        "surfaceFile": assets["surfaceFile"],
-        "threeRevision": THREE_RELEASE["revision"],
-        "bodyScale": rig.body_scale,
-        "slotCount": rig.slot_count,
+        surface_file=assets["surfaceFile"],
+        three_revision=THREE_RELEASE["revision"],
+        body_scale=rig.body_scale,
+        slot_count=rig.slot_count,
         # One extra "part" per instance: the root rows (position + alive, yaw cos/sin + squash + size).
-        "maxParts": rig.slot_count + 1,
-        "poseRows": POSE_ROWS,
-        "slots": rig.slots.tolist(),
-        "slotNames": list(skeleton.names),
-        "roundCone": [int(x) for x in slot_uses_round_cone(rig.slots)],
-        "lcg": {"a": LCG_A, "c": LCG_C},
+        max_parts=rig.slot_count + 1,
+        pose_rows=POSE_ROWS,
+        slots=tuple(tuple(row) for row in rig.slots.tolist()),
+        slot_names=tuple(skeleton.names),
+        round_cone=tuple(int(x) for x in slot_uses_round_cone(rig.slots)),
+        lcg=LCG,
         # Colour genes mutate these OKLab coordinates of the authored colours (model/genome.py).
-        "genetics": genetics_data(spec.genetics),
-        "slotLab": slot_lab(rig.slots[:, col.RGB]),
-        "motion": motion,
-        "tickRate": motion["hz"],
-        "programData": program_data(tapes),
-        "programCount": len(tapes),
-        "fullProgram": len(tapes) - 1,
-        "noProgram": NO_PROGRAM,
-        "skinProgram": SKIN_PROGRAM,
-        "registers": max(len(t) for t in tapes),
-        "candidateNote": note,
-        "gradientFloor": GRADIENT_FLOOR,
-        "tiny": float(np.finfo(np.float32).tiny),
-        "kFloor": floors.k_floor,
-        "correction": {
-            "budget": correction.DEFAULT_BUDGET,
-            "earlyOut": correction.EARLY_OUT,
-            "gradientFloor": correction.GRADIENT_FLOOR,
-        },
-        "mesh": {"vertices": asset.vertex_count, "triangles": int(asset.indices.size // 3)},
-        "debugModes": list(DEBUG_MODES),
-        "deformStride": DEFORM_STRIDE,
-    }
+        genetics=genetics_data(spec.genetics),
+        slot_lab=tuple((big_l, a, b) for big_l, a, b in slot_lab(rig.slots[:, col.RGB])),
+        motion=motion,
+        tick_rate=motion.hz,
+        program_data=tuple(program_data(tapes)),
+        program_count=len(tapes),
+        full_program=len(tapes) - 1,
+        no_program=NO_PROGRAM,
+        skin_program=SKIN_PROGRAM,
+        registers=max(len(t) for t in tapes),
+        candidate_note=note,
+        gradient_floor=GRADIENT_FLOOR,
+        tiny=float(np.finfo(np.float32).tiny),
+        k_floor=floors.k_floor,
+        correction=CorrectionData(correction.DEFAULT_BUDGET, correction.EARLY_OUT, correction.GRADIENT_FLOOR),
+        mesh=MeshCounts(asset.vertex_count, int(asset.indices.size // 3)),
+        debug_modes=DEBUG_MODES,
+        deform_stride=DEFORM_STRIDE,
+    )
 
 
-def _usage(motion: dict[str, Any]) -> dict[str, str]:
+def _usage(motion: MotionData) -> dict[str, str]:
     """The README's minimal page (examples/minimal.js): a swimmer needs a water provider (the template
     only prints these)."""
-    swims = motion["type"] == "swimmer"
+    swims = motion.type == "swimmer"
     water = ["createAnalyticWater"] if swims else []
     return {
         "imports": ", ".join(["CREATURE", *water, "createCreaturePopulation"]),
@@ -208,7 +210,7 @@ def _usage(motion: dict[str, Any]) -> dict[str, str]:
 
 
 def _workload(
-    rig: CompiledRig, surface: SurfaceBuild, runtime: dict[str, Any], tapes: list[Tape]
+    rig: CompiledRig, surface: SurfaceBuild, runtime: CreatureData, tapes: list[Tape]
 ) -> dict[str, Any]:
     """``plan["workload"]``: what one body costs per frame at this tier (the README's workload table)."""
     asset = surface.asset
@@ -225,14 +227,14 @@ def _workload(
     return {
         "tier": surface.tier,
         "slots": rig.slot_count,
-        "K": runtime["registers"],
+        "K": runtime.registers,
         "programs": len(tapes),
         "vertices": asset.vertex_count,
-        "triangles": runtime["mesh"]["triangles"],
+        "triangles": runtime.mesh.triangles,
         "correctedVertices": corrected,
         "fieldVertices": int(in_field.sum()),
         "leafEvaluationsPerBody": leaf_evaluations,
-        "poseBytesPerBody": runtime["maxParts"] * POSE_ROWS * 16,
+        "poseBytesPerBody": runtime.max_parts * POSE_ROWS * 16,
         # The deform pre-pass storage (tsl/deform.js DEFORM_STRIDE vec4 per vertex).
         "deformBytesPerBody": asset.vertex_count * DEFORM_STRIDE * 16,
     }

@@ -9,7 +9,6 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
 
 import numpy as np
 import numpy.typing as npt
@@ -21,6 +20,7 @@ from ..model.genome import draw_genome, genetics_data, genome_colours, slot_lab
 from ..model.graph import Ref
 from ..model.rotations import Pose, posed_slots
 from ..model.skeleton import build_skeleton
+from ..motion.data import MotionData
 from ..motion.providers import AnalyticWater
 from ..motion.rig import build_motion
 from ..motion.simulate import Motion
@@ -43,7 +43,7 @@ PROBE_MIX = {"caps": 0.25, "taper": 0.25, "blends": 0.25}
 class PackageReference:
     spec: CharacterSpec
     rig: CompiledRig
-    motion: dict[str, Any]  # CREATURE.motion, rebuilt from the spec
+    motion: MotionData  # CREATURE.motion, rebuilt from the spec
     asset: SurfaceAsset
 
 

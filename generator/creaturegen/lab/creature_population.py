@@ -121,7 +121,7 @@ def grid_gates(page: Page, ref: cref.PackageReference, package: Path, report: Pa
         colour_rows = got[: slots * POSE_ROWS * 4].reshape(slots, POSE_ROWS, 4)[:, 2, 1:4]
         worst_colour = max(worst_colour, float(np.abs(colour_rows - np.asarray(mine, np.float32)).max()))
         colours.append(colour_rows.astype(np.float64).ravel())
-        speeds.append(motion.data["speed"] / ref.motion["speed"] if ref.motion["speed"] > 0 else 1.0)
+        speeds.append(motion.data.speed / ref.motion.speed if ref.motion.speed > 0 else 1.0)
         sizes.append(motion.size)
     report.gate(
         f"genome colours of {len(bodies)} individuals: GPU pose rows vs Python (OKLab mutation)",

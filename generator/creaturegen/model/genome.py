@@ -8,8 +8,9 @@ starts at ``mix_seed(seed)`` (draw 1 is reserved, draw 2 is the heading, see lcg
   only input: its OKLab coordinates are computed at build time (``slot_lab``) and shipped; the runtime
   only mutates them and converts back (cubes and 3×3 products, no cube root), so Python and JS agree bit
   for bit.
-- draws 6, 7, 8: one gait gene per group of the locomotion type's gene list (``motion["genes"]``), each
-  scaling its parameters by ``1 + jitter·gene``; a walker's step length stays within its reach limit.
+- draws 6, 7, 8: one gait gene per group of the locomotion type's gene list (the motion data's ``genes``),
+  each scaling its parameters by ``1 + jitter·gene`` (motion/express.py); a walker's step length stays
+  within its reach limit.
 - draw 9: size, ``1 + genes.size·gene``. Size is the one morphology gene a spawn may carry, because it is a
   similarity: the rest geometry (slot ends, radii, blend widths; the mesh's vertices and centres of
   rotation) and every length of the motion data scale together, so the field of an individual of size s is
@@ -28,13 +29,14 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import Any, Final
+from typing import Final
 
 import numpy as np
 import numpy.typing as npt
 
 from ..spec.character import Genetics
 from .lcg import lcg_next, mix_seed
+from .record import JsonRecord
 from .trig import pcos, psin
 
 #: Draw index (1-based) of each gene; the gait genes follow GAIT_DRAW in gene-list order.
@@ -131,12 +133,12 @@ def linear_from_oklab(lab: tuple[float, float, float]) -> tuple[float, float, fl
     )
 
 
-def genome_colours(genetics: dict[str, Any], lab: list[list[float]], genome: Genome) -> list[list[float]]:
+def genome_colours(genetics: ColourGenetics, lab: list[list[float]], genome: Genome) -> list[list[float]]:
     """Per-slot linear rgb of an individual: hue rotated, chroma scaled and lightness shifted in OKLab."""
-    angle = genetics["hueRad"] * genome.hue
+    angle = genetics.hue_rad * genome.hue
     cos, sin = pcos(angle), psin(angle)
-    scale = 1.0 + genetics["chroma"] * genome.chroma
-    shift = genetics["lightness"] * genome.lightness
+    scale = 1.0 + genetics.chroma * genome.chroma
+    shift = genetics.lightness * genome.lightness
     out = []
     for big_l, a, b in lab:
         lightness = min(1.0, max(0.0, big_l + shift))
@@ -146,57 +148,19 @@ def genome_colours(genetics: dict[str, Any], lab: list[list[float]], genome: Gen
     return out
 
 
-def genetics_data(genetics: Genetics) -> dict[str, float]:
+@dataclass(frozen=True, slots=True)
+class ColourGenetics(JsonRecord):
+    """The bounds of the colour genes, as the runtime reads them (CREATURE.genetics): each gene in [-1, 1)
+    times its bound."""
+
+    hue_rad: float
+    """Largest hue rotation, radians (the spec states degrees)."""
+    chroma: float
+    """Largest relative change of chroma."""
+    lightness: float
+    """Largest shift of OKLab lightness."""
+
+
+def genetics_data(genetics: Genetics) -> ColourGenetics:
     """The plan's colour genetics (the hue bound in radians, as the runtime reads it)."""
-    return {"hueRad": math.radians(genetics.hue), "chroma": genetics.chroma, "lightness": genetics.lightness}
-
-
-def express_gait(motion: dict[str, Any], genome: Genome) -> dict[str, Any]:
-    """The motion data of an individual: gait gene ``i`` scales every field of ``genes.fields[i]`` by
-    ``1 + jitter·gene``. The authored data is not modified.
-
-    A walker's pace gene scales speed and stepLength together, so its stance lasts the same number of ticks
-    and its phase windows open as authored; the factor is capped where stepLength would pass the reach
-    limit (``stepLimit``). Scaling speed alone, or step length alone, lets a foot lag past its reach
-    before its window opens (tests/test_motion.py checks every corner of the gene box).
-    """
-    genes = motion["genes"]
-    expressed = dict(motion)
-    for i, group in enumerate(genes["fields"]):
-        factor = 1.0 + genes["jitter"] * genome.gait[i]
-        if "stepLength" in group and motion["stepLength"] > 0.0:
-            factor = min(factor, motion["stepLimit"] / motion["stepLength"])
-        for name in group:
-            expressed[name] = motion[name] * factor
-    return expressed
-
-
-def individual_size(motion: dict[str, Any], genome: Genome) -> float:
-    """The size factor of an individual: ``1 + genes.size·gene`` (1 when the spec's bound is 0)."""
-    return 1.0 + float(motion["genes"]["size"]) * genome.size
-
-
-def _scaled(value: Any, factor: float) -> Any:
-    return [_scaled(v, factor) for v in value] if isinstance(value, list) else value * factor
-
-
-def express_size(motion: dict[str, Any], size: float) -> dict[str, Any]:
-    """The motion data of an individual of ``size``: every length ``motion["lengths"]`` names (top-level,
-    and per leg, rope and wing) times ``size``, nested lists element by element, and every speed times
-    √size (Froude similarity, motion/rig.py SIZED_FIELDS). The authored data is not modified."""
-    names = motion["lengths"]
-    expressed = dict(motion)
-    for name in names["speeds"]:
-        expressed[name] = motion[name] * math.sqrt(size)
-    for name in names["top"]:
-        expressed[name] = _scaled(motion[name], size)
-    for group in ("legs", "ropes", "wings"):
-        expressed[group] = [
-            {**item, **{name: _scaled(item[name], size) for name in names[group]}} for item in motion[group]
-        ]
-    return expressed
-
-
-def express(motion: dict[str, Any], genome: Genome) -> dict[str, Any]:
-    """The motion data of an individual: its size first, then its gait genes (core/genome.js express)."""
-    return express_gait(express_size(motion, individual_size(motion, genome)), genome)
+    return ColourGenetics(math.radians(genetics.hue), genetics.chroma, genetics.lightness)

@@ -7,9 +7,8 @@ stages then overwrite their own slots (the last stage touching a slot wins).
 
 from __future__ import annotations
 
-from typing import Any
-
 from . import quat as vq
+from .data import MotionData
 from .flight import wing_locals
 from .quat import Vec
 from .state import MotionState
@@ -25,7 +24,7 @@ def base_pose(m: MotionState, time: float) -> None:
             compose_base(data, {}, m.quats, m.trans)
             m.rest_pose = ([list(q) for q in m.quats], [list(t) for t in m.trans])
         quats, trans = m.rest_pose
-        for s in data["order"]:
+        for s in data.order:
             m.quats[s], m.trans[s] = list(quats[s]), list(trans[s])
         return
     locals_ = wing_locals(data, d, time) if m.kind == "flyer" else undulation_locals(data, d, time)
@@ -33,12 +32,12 @@ def base_pose(m: MotionState, time: float) -> None:
 
 
 def compose_base(
-    data: dict[str, Any], locals_: dict[int, list[float]], quats: list[list[float]], trans: list[Vec]
+    data: MotionData, locals_: dict[int, list[float]], quats: list[list[float]], trans: list[Vec]
 ) -> None:
     """Per-slot local rotations (identity where absent) composed down the skeleton about the pivots, into
     ``quats`` and ``trans``."""
-    parent, pivot = data["parent"], data["pivot"]
-    for s in data["order"]:
+    parent, pivot = data.parent, data.pivot
+    for s in data.order:
         local = locals_.get(s, list(vq.IDENTITY))
         pv = pivot[s]
         turned = vq.rotate(local, pv)

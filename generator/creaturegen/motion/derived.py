@@ -9,7 +9,8 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import Any
+
+from .data import MotionData
 
 #: The longest interval a locomotion parameter may ask for (an hour): past it, or infinite, the tick
 #: counts stop being numbers a build can step (a valid ``hopHeight: 1e308`` overflowed here).
@@ -54,23 +55,23 @@ class Derived:
     swim_depth: float
     undulation_hz: float
 
-    def as_dict(self) -> dict[str, Any]:
+    def as_dict(self) -> dict[str, float]:
         return dict(self.__dict__)
 
 
-def derive(data: dict[str, Any], gravity: list[float]) -> Derived:
-    hz = int(data["hz"])
+def derive(data: MotionData, gravity: list[float]) -> Derived:
+    hz = int(data.hz)
     dt = 1.0 / hz
     g = math.sqrt(gravity[0] * gravity[0] + gravity[1] * gravity[1] + gravity[2] * gravity[2])
-    c = data["constants"]
-    speed = data["speed"]
-    body = data["bodyScale"]
-    legs = data["legs"]
+    c = data.constants
+    speed = data.speed
+    body = data.body_scale
+    legs = data.legs
     swing = window = cycle = 0
     if legs:
-        leg_len = sum(leg["a"] + leg["b"] for leg in legs) / len(legs)
-        swing = max(2, ticks_from_seconds(c["swingFroude"] * math.sqrt(leg_len / g), hz))
-        groups = data["groups"]
+        leg_len = sum(leg.a + leg.b for leg in legs) / len(legs)
+        swing = max(2, ticks_from_seconds(c.swing_froude * math.sqrt(leg_len / g), hz))
+        groups = data.groups
         # A foot lands stepLead·s ahead of home and lifts once it lags s behind: planted for
         # (1 + stepLead)·s / v seconds. The cycle is that stance plus the swing, a whole number of
         # windows, so a steady gait lifts each group right as its window opens. The stance is rounded
@@ -79,38 +80,38 @@ def derive(data: dict[str, Any], gravity: list[float]) -> Derived:
         # waited a whole cycle, its foot lagging past its reach (the quadruped at the large size corner).
         stance = 0
         if speed > 0.0:
-            stance = math.floor((1.0 + c["stepLead"]) * data["stepLength"] / (speed * dt)) + 2
+            stance = math.floor((1.0 + c.step_lead) * data.step_length / (speed * dt)) + 2
         window = max(swing + 1, -(-(swing + stance) // groups))
         cycle = groups * window
-    half_air = max(1, ticks_from_seconds(math.sqrt(2.0 * data["hopHeight"] / g), hz))
+    half_air = max(1, ticks_from_seconds(math.sqrt(2.0 * data.hop_height / g), hz))
     air = 2 * half_air
-    crouch = max(2, ticks_from_seconds(c["hopCrouchS"], hz))
-    land = max(2, ticks_from_seconds(c["hopLandS"], hz))
+    crouch = max(2, ticks_from_seconds(c.hop_crouch_s, hz))
+    land = max(2, ticks_from_seconds(c.hop_land_s, hz))
     busy = crouch + air + land
     hop_cycle = busy + 1
-    if speed > 0.0 and data["hopLength"] > 0.0:
-        hop_cycle = max(busy + 1, ticks_from_seconds(data["hopLength"] / speed, hz))
+    if speed > 0.0 and data.hop_length > 0.0:
+        hop_cycle = max(busy + 1, ticks_from_seconds(data.hop_length / speed, hz))
     dip = 0.0
-    if data["type"] == "hopper" and legs:
+    if data.type == "hopper" and legs:
         # The legs' mean rest hip height above their feet, times each leg's crouch fraction.
         for leg in legs:
-            dip = dip + leg["crouch"] * (leg["hip"][1] - leg["foot"][1])
+            dip = dip + leg.crouch * (leg.hip[1] - leg.foot[1])
         dip = dip / len(legs)
     t_half = half_air * dt
     v0 = g * t_half
     flap_hz = 0.0
-    wings = data["wings"]
+    wings = data.wings
     if wings:
-        excursion = max(2.0 * w["amplitude"] * w["length"] for w in wings)
-        flap_hz = c["strouhal"] * speed / excursion if excursion > 0.0 else 0.0
-    radius = data["pathRadius"]
+        excursion = max(2.0 * w.amplitude * w.length for w in wings)
+        flap_hz = c.strouhal * speed / excursion if excursion > 0.0 else 0.0
+    radius = data.path_radius
     bank = math.atan2(speed * speed, g * radius) if radius > 0.0 else 0.0
     # Coordinated turn: tan β = v²/(g R); cos β from a square root, then the half angle, so no library
     # trigonometry reaches the pose.
     lift = g * radius
     cos_bank = lift / math.sqrt(speed * speed * (speed * speed) + lift * lift) if radius > 0.0 else 1.0
-    undulation = data["undulation"]
-    undulation_hz = c["strouhal"] * speed / (2.0 * undulation * body) if undulation > 0.0 else 0.0
+    undulation = data.undulation
+    undulation_hz = c.strouhal * speed / (2.0 * undulation * body) if undulation > 0.0 else 0.0
     return Derived(
         hz=hz,
         dt=dt,
@@ -131,7 +132,7 @@ def derive(data: dict[str, Any], gravity: list[float]) -> Derived:
         bank=bank,
         bank_half_sin=math.sqrt((1.0 - cos_bank) * 0.5),
         bank_half_cos=math.sqrt((1.0 + cos_bank) * 0.5),
-        swim_omega=c["swimResponse"] * math.sqrt(g / body),
-        swim_depth=(1.0 - data["buoyancy"]) * body,
+        swim_omega=c.swim_response * math.sqrt(g / body),
+        swim_depth=(1.0 - data.buoyancy) * body,
         undulation_hz=undulation_hz,
     )

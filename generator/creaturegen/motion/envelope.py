@@ -50,13 +50,15 @@ import numpy.typing as npt
 from ..cachedir import default_cache_root
 from ..codedigest import stage_digest
 from ..model import layout as col
-from ..model.genome import MAX_GAIT_GENES, Genome, express
+from ..model.genome import MAX_GAIT_GENES, Genome
 from ..model.lcg import instance_yaw
 from ..model.rotations import Pose, quaternion_multiply, quaternion_to_matrix
 from ..model.skeleton import Skeleton, build_skeleton, joint_frame
 from ..rig import CompiledRig
 from ..spec import CharacterSpec
+from .data import MotionData
 from .derived import MotionRangeError, derive
+from .express import express
 from .providers import AnalyticWater, FlatGround, Gravity, Support, builtin_supports
 from .rig import WALKERS, build_motion
 from .simulate import Motion
@@ -162,10 +164,10 @@ class PoseEnvelope:
         }
 
 
-def _period(data: dict[str, Any]) -> int:
+def _period(data: MotionData) -> int:
     """Ticks of one cycle of an individual's motion (0 where it has none)."""
     d = derive(data, Gravity().at(0.0))
-    kind = data["type"]
+    kind = data.type
     if kind in WALKERS:
         return d.cycle
     if kind == "hopper":
@@ -177,29 +179,29 @@ def _period(data: dict[str, Any]) -> int:
     return 0
 
 
-def run_ticks(data: dict[str, Any], runs: int = 1) -> int:
+def run_ticks(data: MotionData, runs: int = 1) -> int:
     """Ticks per run: CYCLES of the slowest corner individual's period (gait and size genes stretch it),
     and at least MIN_SECONDS; refused when ``runs`` such runs exceed MAX_ENVELOPE_TICKS."""
     period = max(_period(express(data, genome)) for _, genome in corner_genomes(data))
-    hz = int(data["hz"])
+    hz = int(data.hz)
     ticks = max(CYCLES * period, math.ceil(MIN_SECONDS * hz))
     if runs * ticks > MAX_ENVELOPE_TICKS:
         raise MotionRangeError(
-            f"locomotion: one {data['type']} cycle lasts {period / hz:.1f} s (at the slowest gene corner): "
+            f"locomotion: one {data.type} cycle lasts {period / hz:.1f} s (at the slowest gene corner): "
             f"{runs} runs of {ticks:,} ticks, over the {MAX_ENVELOPE_TICKS:,} the motion envelope steps; "
             "lower the locomotion lengths and heights (or the scale), or raise locomotion.speed"
         )
     return ticks
 
 
-def corner_genomes(data: dict[str, Any]) -> list[tuple[str, Genome]]:
+def corner_genomes(data: MotionData) -> list[tuple[str, Genome]]:
     """The authored genome and every corner of the box of gait genes and size (colour genes move no
     slot); a gene whose bound is 0 stays at 0."""
-    genes = data["genes"]
-    count = len(genes["fields"]) if genes["jitter"] > 0.0 else 0
-    axes = [(-1.0, 1.0)] * count + [(-1.0, 1.0) if genes["size"] > 0.0 else (0.0,)]
+    genes = data.genes
+    count = len(genes.fields) if genes.jitter > 0.0 else 0
+    axes = [(-1.0, 1.0)] * count + [(-1.0, 1.0) if genes.size > 0.0 else (0.0,)]
     out = [("authored", Genome(0.0, 0.0, 0.0, (0.0,) * MAX_GAIT_GENES))]
-    if count or genes["size"] > 0.0:
+    if count or genes.size > 0.0:
         for *signs, size in itertools.product(*axes):
             words = ["genes " + "".join("+" if s > 0 else "-" for s in signs)] if signs else []
             words += [{1.0: "size +", -1.0: "size -"}[size]] if size else []
@@ -225,7 +227,7 @@ def heading_seeds() -> tuple[int, ...]:
     return tuple(seeds)
 
 
-def envelope_runs(data: dict[str, Any]) -> list[tuple[str, Motion]]:
+def envelope_runs(data: MotionData) -> list[tuple[str, Motion]]:
     """Every genome corner on every support the creature can be given, at every heading where the
     support is not the same in all directions."""
     runs = []
@@ -240,16 +242,16 @@ def envelope_runs(data: dict[str, Any]) -> list[tuple[str, Motion]]:
     return runs
 
 
-def envelope_supports(data: dict[str, Any]) -> dict[str, Support]:
+def envelope_supports(data: MotionData) -> dict[str, Support]:
     """The built-in supports for a creature that stands on one, else flat ground (never consulted)."""
-    kind = data["type"]
+    kind = data.type
     return builtin_supports() if kind in WALKERS or kind == "hopper" else {"flat": FlatGround()}
 
 
-def individual(data: dict[str, Any], support: Support, seed: int, genome: Genome | None = None) -> Motion:
+def individual(data: MotionData, support: Support, seed: int, genome: Genome | None = None) -> Motion:
     """The individual spawned from ``seed`` (its genome unless one is given) on ``support``; a swimmer
     on the analytic water."""
-    water = AnalyticWater() if data["type"] == "swimmer" else None
+    water = AnalyticWater() if data.type == "swimmer" else None
     return Motion(data, support=support, water=water, genome=genome, seed=seed)
 
 
@@ -312,7 +314,7 @@ def _step_runs(motions: list[Motion], ticks: int, workers: int) -> list[tuple[F6
 
 
 def _record(
-    data: dict[str, Any], runs: list[tuple[str, Motion]], workers: int = 1
+    data: MotionData, runs: list[tuple[str, Motion]], workers: int = 1
 ) -> tuple[list[str], int, F64, F64, list[str]]:
     """(run labels, ticks per run, quaternions (N, S, 4) wxyz, translations (N, S, 3) of the unit body,
     sample labels)."""
@@ -383,7 +385,7 @@ def _farthest(points: F64, count: int, first: int) -> list[int]:
 
 
 def measure_envelope(
-    data: dict[str, Any], rest: F64, skeleton: Skeleton, runs: list[tuple[str, Motion]] | None = None
+    data: MotionData, rest: F64, skeleton: Skeleton, runs: list[tuple[str, Motion]] | None = None
 ) -> PoseEnvelope:
     """Step every run (by default :func:`envelope_runs`, stepped by :func:`envelope_workers` processes),
     measure every joint and slot, and pick the whole-body sweep poses. Runs passed in are stepped here."""
@@ -396,7 +398,7 @@ def measure_envelope(
 
 
 def _summarise(
-    data: dict[str, Any],
+    data: MotionData,
     rest: F64,
     skeleton: Skeleton,
     labels: list[str],
@@ -406,7 +408,7 @@ def _summarise(
     sample_labels: list[str],
 ) -> PoseEnvelope:
     """The envelope of the recorded runs: every joint and slot measured, the sweep poses picked."""
-    root = int(data["roots"][0])
+    root = int(data.roots[0])
     q, t = _root_frame(quats, trans, root)
     runs = [label.rsplit(" tick ", 1)[0] for label in sample_labels]
     joints = tuple(_joint(skeleton, rest, q, t, p, c, runs) for p, c in skeleton.joints)
@@ -478,7 +480,7 @@ class PendingEnvelope:
         self,
         key: str,
         ready: PoseEnvelope | None,
-        measure: tuple[dict[str, Any], F64, Skeleton] | None = None,
+        measure: tuple[MotionData, F64, Skeleton] | None = None,
     ) -> None:
         self._key, self._ready, self._measure = key, ready, measure
         self._pool: Any = None
@@ -540,7 +542,7 @@ def start_pose_envelope(
         skeleton = build_skeleton(spec, rig)
     data = build_motion(spec, rig, skeleton)
     key = hashlib.sha256(
-        json.dumps(data, sort_keys=True).encode()
+        json.dumps(data.to_json(), sort_keys=True).encode()
         + rig.slots.tobytes()
         + stage_digest("creaturegen.motion.envelope").encode()
     ).hexdigest()

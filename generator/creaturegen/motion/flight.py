@@ -10,21 +10,22 @@ the skeleton.
 from __future__ import annotations
 
 import math
-from typing import Any, Final
+from typing import Final
 
 from ..model.trig import psin
 from . import quat as vq
+from .data import MotionData
 from .derived import Derived
 
 Z_AXIS: Final = [0.0, 0.0, 1.0]
 
 
-def wing_locals(data: dict[str, Any], d: Derived, time: float) -> dict[int, list[float]]:
+def wing_locals(data: MotionData, d: Derived, time: float) -> dict[int, list[float]]:
     """Slot → local rotation of a flyer at ``time``: its bank at the roots, its flap at the wings."""
     locals_: dict[int, list[float]] = {}
-    for r in data["roots"]:
+    for r in data.roots:
         locals_[r] = [0.0, 0.0, d.bank_half_sin, d.bank_half_cos]
     flap = psin(2.0 * math.pi * d.flap_hz * time)
-    for wing in data["wings"]:
-        locals_[wing["slot"]] = vq.axis_angle(Z_AXIS, wing["sign"] * wing["amplitude"] * flap)
+    for wing in data.wings:
+        locals_[wing.slot] = vq.axis_angle(Z_AXIS, wing.sign * wing.amplitude * flap)
     return locals_

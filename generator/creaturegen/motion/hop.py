@@ -9,9 +9,9 @@ walker's leg placement (gait.place_leg).
 from __future__ import annotations
 
 import math
-from typing import Any
 
 from ..model.trig import psin
+from .data import MotionData
 from .derived import Derived
 from .gait import count_planted, home, place_leg
 from .providers import Frame, to_world
@@ -19,28 +19,28 @@ from .root import to_local_root
 from .state import MotionState
 
 
-def hop_at(data: dict[str, Any], d: Derived, n: int) -> tuple[float, float, float]:
+def hop_at(data: MotionData, d: Derived, n: int) -> tuple[float, float, float]:
     """(distance along the path, height above the support, squash) of the hopper at tick ``n``. In the
     crouch and the landing a hopper on legs also sinks on them (``dip``, 0 without legs)."""
-    c = data["constants"]
-    hop_length = data["hopLength"] if data["speed"] > 0.0 else 0.0
+    c = data.constants
+    hop_length = data.hop_length if data.speed > 0.0 else 0.0
     k, m = divmod(n, d.hop_cycle)
     if m < d.hop_idle:
         return k * hop_length, 0.0, 1.0
     m -= d.hop_idle
     if m < d.crouch:
         sink = psin(math.pi * (m / d.crouch))
-        return k * hop_length, 0.0 - d.dip * sink, 1.0 - c["hopSquash"] * sink
+        return k * hop_length, 0.0 - d.dip * sink, 1.0 - c.hop_squash * sink
     m -= d.crouch
     if m < d.air:
         ts = m * d.dt
         tau = m / d.air
         e = 2.0 * tau - 1.0
         y = d.v0 * ts - 0.5 * d.g * ts * ts
-        return k * hop_length + hop_length * tau, y, 1.0 + c["hopStretch"] * (e * e)
+        return k * hop_length + hop_length * tau, y, 1.0 + c.hop_stretch * (e * e)
     m -= d.air
     sink = psin(math.pi * (m / d.land))
-    return (k + 1) * hop_length, 0.0 - d.dip * sink, 1.0 - c["hopSquash"] * sink
+    return (k + 1) * hop_length, 0.0 - d.dip * sink, 1.0 - c.hop_squash * sink
 
 
 def hop_gates(m: MotionState, n: int, root: list[float]) -> None:
@@ -68,7 +68,7 @@ def hop_legs(m: MotionState, n: int, frame: Frame, integrate: bool) -> None:
     phase = n % d.hop_cycle
     airborne = d.hop_idle + d.crouch <= phase < d.hop_idle + d.crouch + d.air
     swinging = 0
-    for leg, foot in zip(m.data["legs"], m.feet, strict=True):
+    for leg, foot in zip(m.data.legs, m.feet, strict=True):
         if not integrate:
             foot.planted, foot.p = True, home(leg, frame, m.root)
         elif foot.planted and airborne:
@@ -87,7 +87,7 @@ def hop_legs(m: MotionState, n: int, frame: Frame, integrate: bool) -> None:
             pull = arc * arc
             a = to_local_root(m.root, to_world(frame, foot.s))
             b = to_local_root(m.root, to_world(frame, foot.t))
-            hip, rest, tuck = leg["hip"], leg["foot"], leg["tuck"]
+            hip, rest, tuck = leg.hip, leg.foot, leg.tuck
             target = [0.0, 0.0, 0.0]
             for k in range(3):
                 base = a[k] + (b[k] - a[k]) * sigma

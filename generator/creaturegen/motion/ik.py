@@ -13,9 +13,9 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import Any
 
 from . import quat as vq
+from .data import LegData
 from .quat import Quat, Vec
 
 
@@ -31,13 +31,13 @@ class IKResult:
     residual: float  # max bone-length error / (a + b)
 
 
-def solve_leg(leg: dict[str, Any], target: Vec) -> IKResult:
-    hip, knee0, foot0, hint = leg["hip"], leg["knee"], leg["foot"], leg["hint"]
-    a, b = leg["a"], leg["b"]
+def solve_leg(leg: LegData, target: Vec) -> IKResult:
+    hip, knee0, foot0, hint = leg.hip, leg.knee, leg.foot, leg.hint
+    a, b = leg.a, leg.b
     d = [target[0] - hip[0], target[1] - hip[1], target[2] - hip[2]]
     dist = vq.length(d)
     u = [0.0, -1.0, 0.0] if dist == 0.0 else [d[0] / dist, d[1] / dist, d[2] / dist]
-    reach = min(max(dist, leg["reachMin"]), leg["reachMax"])
+    reach = min(max(dist, leg.reach_min), leg.reach_max)
     clamped = reach != dist
     v = vq.gram_schmidt(hint, u)
     cos_a = (a * a + reach * reach - b * b) / (2.0 * a * reach)
@@ -45,7 +45,7 @@ def solve_leg(leg: dict[str, Any], target: Vec) -> IKResult:
     sin_a = math.sqrt(1.0 - cos_a * cos_a)
     knee = [hip[i] + a * (cos_a * u[i] + sin_a * v[i]) for i in range(3)]
     foot = [hip[i] + reach * u[i] for i in range(3)]
-    hinge0 = leg["hinge"]
+    hinge0 = leg.hinge
     hinge1 = vq.normalize(vq.cross(u, v))
     thigh0 = vq.normalize([knee0[0] - hip[0], knee0[1] - hip[1], knee0[2] - hip[2]])
     thigh1 = vq.normalize([knee[0] - hip[0], knee[1] - hip[1], knee[2] - hip[2]])

@@ -10,6 +10,7 @@ from __future__ import annotations
 
 from typing import Any, Final
 
+from .data import MotionData
 from .driver import Driver, interpolate_root, interpolate_slot
 from .providers import AnalyticWater, builtin_supports
 from .simulate import Motion
@@ -21,7 +22,7 @@ DRIVER_FRAMES: Final = (0.016, 0.017, 0.0, 0.05, 0.016, 0.4, 0.016, -0.01, 0.033
 SEEDS: Final = (7, 90210)
 
 
-def run_case(data: dict[str, Any], support: str, seed: int) -> dict[str, Any]:
+def run_case(data: MotionData, support: str, seed: int) -> dict[str, Any]:
     motion = Motion(data, support=builtin_supports()[support], water=AnalyticWater(), seed=seed)
     frames = []
     for tick in range(PARITY_TICKS[-1] + 1):
@@ -58,13 +59,13 @@ def driver_trace(hz: int) -> list[dict[str, float]]:
     return out
 
 
-def motion_reference(data: dict[str, Any]) -> dict[str, Any]:
+def motion_reference(data: MotionData) -> dict[str, Any]:
     cases = [run_case(data, support, SEEDS[0]) for support in builtin_supports()]
     cases.append(run_case(data, "flat", SEEDS[1]))
     return {
         "relative": RELATIVE,
-        "bodyScale": data["bodyScale"],
+        "bodyScale": data.body_scale,
         "ticks": list(PARITY_TICKS),
         "cases": cases,
-        "driver": {"hz": data["hz"], "frames": driver_trace(int(data["hz"]))},
+        "driver": {"hz": data.hz, "frames": driver_trace(int(data.hz))},
     }

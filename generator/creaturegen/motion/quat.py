@@ -7,16 +7,19 @@ the parity law pins Python and JS to ~1e-15, which only holds when both evaluate
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 
 from ..model.trig import pcos, psin
 
 Vec = list[float]
 Quat = list[float]
+#: A 3-vector argument that is only read: a list, or a tuple of the frozen motion data (motion/data.py).
+Point = Sequence[float]
 
 IDENTITY: tuple[float, float, float, float] = (0.0, 0.0, 0.0, 1.0)
 
 
-def rotate(q: Quat, v: Vec) -> Vec:
+def rotate(q: Quat, v: Point) -> Vec:
     """R(q)·v by ``v + 2w(u×v) + 2u×(u×v)``."""
     x, y, z, w = q
     cx = y * v[2] - z * v[1]
@@ -40,21 +43,21 @@ def mul(a: Quat, b: Quat) -> Quat:
     ]
 
 
-def axis_angle(axis: Vec, angle: float) -> Quat:
+def axis_angle(axis: Point, angle: float) -> Quat:
     half = 0.5 * angle
     s = psin(half)
     return [axis[0] * s, axis[1] * s, axis[2] * s, pcos(half)]
 
 
-def dot(a: Vec, b: Vec) -> float:
+def dot(a: Point, b: Point) -> float:
     return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
 
 
-def cross(a: Vec, b: Vec) -> Vec:
+def cross(a: Point, b: Point) -> Vec:
     return [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]]
 
 
-def length(a: Vec) -> float:
+def length(a: Point) -> float:
     return math.sqrt(a[0] * a[0] + a[1] * a[1] + a[2] * a[2])
 
 
@@ -64,16 +67,16 @@ def norm3(x: float, y: float, z: float) -> float:
     return math.sqrt(x * x + y * y + z * z)
 
 
-def distance(a: Vec, b: Vec) -> float:
+def distance(a: Point, b: Point) -> float:
     return norm3(a[0] - b[0], a[1] - b[1], a[2] - b[2])
 
 
-def normalize(a: Vec) -> Vec:
+def normalize(a: Point) -> Vec:
     n = length(a)
     return [a[0] / n, a[1] / n, a[2] / n]
 
 
-def gram_schmidt(hint: Vec, u: Vec) -> Vec:
+def gram_schmidt(hint: Point, u: Point) -> Vec:
     """The unit component of ``hint`` orthogonal to unit ``u`` (the knee's bend direction); when the hint
     is parallel to ``u`` the x axis (then z) stands in, so the frame is always defined."""
     h = dot(hint, u)
@@ -85,7 +88,7 @@ def gram_schmidt(hint: Vec, u: Vec) -> Vec:
     return normalize(v)
 
 
-def from_frames(u0: Vec, v0: Vec, u1: Vec, v1: Vec) -> Quat:
+def from_frames(u0: Point, v0: Point, u1: Point, v1: Point) -> Quat:
     """The rotation taking orthonormal frame (u0, v0, u0×v0) to (u1, v1, u1×v1), by Shepperd's method."""
     w0 = cross(u0, v0)
     w1 = cross(u1, v1)
@@ -104,7 +107,7 @@ def from_frames(u0: Vec, v0: Vec, u1: Vec, v1: Vec) -> Quat:
     return [(m[0][2] + m[2][0]) / s, (m[1][2] + m[2][1]) / s, 0.25 * s, (m[1][0] - m[0][1]) / s]
 
 
-def from_to(e0: Vec, e1: Vec) -> Quat:
+def from_to(e0: Point, e1: Point) -> Quat:
     """The shortest rotation taking unit ``e0`` to unit ``e1`` (a half-turn about a perpendicular axis
     when they are opposite)."""
     d = dot(e0, e1)
@@ -117,10 +120,10 @@ def from_to(e0: Vec, e1: Vec) -> Quat:
     return [q[0] / n, q[1] / n, q[2] / n, q[3] / n]
 
 
-def yaw_rotate(c: float, s: float, v: Vec) -> Vec:
+def yaw_rotate(c: float, s: float, v: Point) -> Vec:
     """The root yaw about +y, as the GPU's rootRotate writes it: forward +z turns to (sin ψ, 0, cos ψ)."""
     return [c * v[0] + s * v[2], v[1], -s * v[0] + c * v[2]]
 
 
-def yaw_unrotate(c: float, s: float, v: Vec) -> Vec:
+def yaw_unrotate(c: float, s: float, v: Point) -> Vec:
     return [c * v[0] - s * v[2], v[1], s * v[0] + c * v[2]]

@@ -1,21 +1,25 @@
 """Build-time motion data: which slots are legs, ropes and wings, rest frames, and the stated constants.
 
-Everything here is plain numbers derived from the compiled rig and skeleton; ``runtime_data`` is what the
-package's core/data.js carries as ``CREATURE.motion``, and the Python reference reads the same object, so
-the two cannot drift apart. Quantities that depend on gravity (swing time, hop air time) are derived at
-runtime from the injected gravity provider, not here.
+Everything here is plain numbers derived from the compiled rig and skeleton; ``build_motion``'s record
+(motion/data.py) is what the package's core/data.js carries as ``CREATURE.motion`` (its JSON), and the
+Python reference reads the same record, so the two cannot drift apart. Quantities that depend on gravity
+(swing time, hop air time) are derived at runtime from the injected gravity provider, not here.
 """
 
 from __future__ import annotations
 
 import math
-from typing import Any, Final
+from collections.abc import Iterable
+from typing import Final
 
 from ..model import layout as col
+from ..model.record import finite_record
 from ..model.skeleton import Skeleton
 from ..rig import CompiledRig
 from ..spec import CharacterSpec, character
+from ..spec.character import LocomotionType
 from . import quat as vq
+from .data import LegData, MotionConstants, MotionData, MotionGenes, RopeData, SizedFields, Vec3, WingData
 
 #: Walkers, hoppers and swimmers circle at this many body lengths (flyers use their spec radius).
 PATH_RADIUS_BODIES: Final = 6.0
@@ -63,23 +67,23 @@ ROPE_BEND_LIMIT_DEG: Final = 60.0
 #: The walking locomotion types (spec/character.py, where validation reads them too).
 WALKERS: Final = character.WALKERS
 #: locomotion type -> its gait genes, each the motion-data fields one gene scales together
-#: (model/genome.py express_gait): pace scales speed with step or hop length, so timing in ticks holds.
+#: (motion/express.py express_gait): pace scales speed with step or hop length, so timing in ticks holds.
 GAIT_GENES: Final[dict[str, tuple[tuple[str, ...], ...]]] = {
     **dict.fromkeys(WALKERS, (("speed", "stepLength"), ("stepHeight",))),
     "hopper": (("speed", "hopLength"), ("hopHeight",)),
     "flyer": (("speed",), ("pathRadius",), ("altitude",)),
     "swimmer": (("speed",), ("undulation",)),
 }
-#: The motion-data fields that are lengths, which an individual's size s scales (model/genome.py
+#: The motion-data fields that are lengths, which an individual's size s scales (motion/express.py
 #: express_size), and those that are speeds, which it scales by √s: Froude similarity (v²/gL held), so with
 #: gravity unscaled every time derived from lengths, speeds and gravity (stance, swing, air, hop cycle, flap
 #: and undulation periods) scales by √s alike and the gait keeps its proportions. The hopper's stated crouch
 #: and landing times (HOP_CROUCH_S, HOP_LAND_S) are seconds and stay. Shipped as ``lengths`` so the JS core
 #: scales the very same fields.
 #: Directions, angles, cosines, ratios, counts and indices are neither.
-SIZED_FIELDS: Final[dict[str, tuple[str, ...]]] = {
-    "speeds": ("speed",),
-    "top": (
+SIZED_FIELDS: Final = SizedFields(
+    speeds=("speed",),
+    top=(
         "bodyScale",
         "groundY",
         "centreY",
@@ -93,80 +97,91 @@ SIZED_FIELDS: Final[dict[str, tuple[str, ...]]] = {
         "altitude",
         "pivot",
     ),
-    "legs": ("hip", "knee", "foot", "a", "b", "reachMin", "reachMax"),
-    "ropes": ("rest", "before", "radius", "segment", "bendMin"),
-    "wings": ("length",),
-}
+    legs=("hip", "knee", "foot", "a", "b", "reachMin", "reachMax"),
+    ropes=("rest", "before", "radius", "segment", "bendMin"),
+    wings=("length",),
+)
+#: The stated constants the motion reads (this module's), shipped with the data.
+CONSTANTS: Final = MotionConstants(
+    swing_froude=SWING_FROUDE,
+    step_lead=STEP_LEAD,
+    settle_slack=SETTLE_SLACK,
+    hop_crouch_s=HOP_CROUCH_S,
+    hop_land_s=HOP_LAND_S,
+    hop_squash=HOP_SQUASH,
+    hop_stretch=HOP_STRETCH,
+    strouhal=STROUHAL,
+    swim_response=SWIM_RESPONSE,
+    rope_substeps=ROPE_SUBSTEPS,
+    rope_passes=ROPE_PASSES,
+    rope_damping=ROPE_DAMPING,
+    rope_bend_limit_deg=ROPE_BEND_LIMIT_DEG,
+)
 
 
-def _v(x: Any) -> list[float]:
-    return [float(c) for c in x]
+def _v(x: Iterable[float]) -> Vec3:
+    a, b, c = (float(v) for v in x)
+    return (a, b, c)
 
 
-def fields_of(loco: Any) -> dict[str, Any]:
-    return loco.model_dump(exclude_none=True) if loco is not None else {}
-
-
-def build_motion(spec: CharacterSpec, rig: CompiledRig, skeleton: Skeleton) -> dict[str, Any]:
-    """``CREATURE.motion``: plain JSON numbers, read by the Python reference and the JS core alike. Every
-    number is finite and none is -0 (:func:`_plain`), so a JSON round trip of the data, or of an individual's
-    copy (core/genome.js express), is exact."""
+def _locomotion_fields(spec: CharacterSpec) -> dict[str, float]:
+    """The spec's locomotion numbers by their JSON names (the type and absent fields left out)."""
     loco = spec.locomotion
-    kind = loco.type if loco is not None else "none"
+    if loco is None:
+        return {}
+    dumped: dict[str, object] = loco.model_dump(exclude_none=True)
+    return {k: v for k, v in dumped.items() if isinstance(v, int | float) and not isinstance(v, bool)}
+
+
+def build_motion(spec: CharacterSpec, rig: CompiledRig, skeleton: Skeleton) -> MotionData:
+    """``CREATURE.motion``: plain JSON numbers, read by the Python reference and the JS core alike. Every
+    number is finite and none is -0 (model/record.py finite_record), so a JSON round trip of the data, or
+    of an individual's copy (core/genome.js express), is exact."""
+    kind: LocomotionType = spec.locomotion.type if spec.locomotion is not None else "none"
     slots = rig.slots
     by_part = _slots_by_part(rig)
     body = float(rig.body_scale)
     phases = sorted({float(p.phase or 0.0) for p in spec.parts if p.shape == "leg"})
     legs = _legs(spec, rig, by_part, phases)
-    ropes = _ropes(spec, rig, skeleton, by_part)
-    wings = _wings(spec, rig, by_part)
-    step_spec = float(fields_of(loco).get("stepLength", 0.0)) * spec.scale
+    fields = _locomotion_fields(spec)
+    step_spec = float(fields.get("stepLength", 0.0)) * spec.scale
     ground, step_limit = _ground_and_step_limit(legs, rig)
-    roots = [s for s in range(rig.slot_count) if skeleton.parent[s] < 0]
+    roots = tuple(s for s in range(rig.slot_count) if skeleton.parent[s] < 0)
     centre_y = sum(0.5 * (float(slots[r, 1]) + float(slots[r, 5])) for r in roots) / len(roots)
-    fields = fields_of(loco)
-    speed = float(fields.get("speed", 0.0))
-    return dict(
-        _plain(
-            {
-                "type": kind,
-                "hz": int(fields.get("tickRate", 60)),
-                "speed": speed,
-                "bodyScale": body,
-                "groundY": ground,
-                "centreY": centre_y,
-                "pathRadius": float(fields["radius"]) * spec.scale
-                if kind == "flyer"
-                else PATH_RADIUS_BODIES * body,
-                "stepLength": min(step_spec, step_limit) if legs else step_spec,
-                "stepLengthSpec": step_spec,
-                "stepLimit": step_limit,
-                "stepHeight": float(fields.get("stepHeight", 0.0)) * spec.scale,
-                "hopLength": float(fields.get("hopLength", 0.0)) * spec.scale,
-                "hopHeight": float(fields.get("hopHeight", 0.0)) * spec.scale,
-                "altitude": float(fields.get("altitude", 0.0)) * spec.scale,
-                "undulation": float(fields.get("undulation", 0.0)),
-                "buoyancy": float(fields.get("buoyancy", 1.0)),
-                "groups": len(phases),
-                "legs": legs,
-                "ropes": ropes,
-                "wings": wings,
-                "roots": roots,
-                "parent": list(skeleton.parent),
-                "order": list(skeleton.order),
-                "pivot": [_v(p) for p in skeleton.pivot],
-                "constants": _constants(),
-                # Rope nodes of creatures that stand on the support stay above it by their radius.
-                "ropeGround": kind in WALKERS or kind == "hopper",
-                "genes": {
-                    "jitter": spec.genetics.gait,
-                    "fields": [list(g) for g in GAIT_GENES.get(kind, ())],
-                    "size": spec.genetics.size,
-                },
-                "lengths": {group: list(names) for group, names in SIZED_FIELDS.items()},
-            }
-        )
+    data = MotionData(
+        type=kind,
+        hz=int(fields.get("tickRate", 60)),
+        speed=float(fields.get("speed", 0.0)),
+        body_scale=body,
+        ground_y=ground,
+        centre_y=centre_y,
+        path_radius=float(fields["radius"]) * spec.scale if kind == "flyer" else PATH_RADIUS_BODIES * body,
+        step_length=min(step_spec, step_limit) if legs else step_spec,
+        step_length_spec=step_spec,
+        step_limit=step_limit,
+        step_height=float(fields.get("stepHeight", 0.0)) * spec.scale,
+        hop_length=float(fields.get("hopLength", 0.0)) * spec.scale,
+        hop_height=float(fields.get("hopHeight", 0.0)) * spec.scale,
+        altitude=float(fields.get("altitude", 0.0)) * spec.scale,
+        undulation=float(fields.get("undulation", 0.0)),
+        buoyancy=float(fields.get("buoyancy", 1.0)),
+        groups=len(phases),
+        legs=legs,
+        ropes=_ropes(spec, rig, skeleton, by_part),
+        wings=_wings(spec, rig, by_part),
+        roots=roots,
+        parent=tuple(skeleton.parent),
+        order=tuple(skeleton.order),
+        pivot=tuple(_v(p) for p in skeleton.pivot),
+        constants=CONSTANTS,
+        # Rope nodes of creatures that stand on the support stay above it by their radius.
+        rope_ground=kind in WALKERS or kind == "hopper",
+        genes=MotionGenes(
+            jitter=spec.genetics.gait, fields=GAIT_GENES.get(kind, ()), size=spec.genetics.size
+        ),
+        lengths=SIZED_FIELDS,
     )
+    return finite_record(data, "motion")
 
 
 def _slots_by_part(rig: CompiledRig) -> dict[str, list[int]]:
@@ -179,10 +194,10 @@ def _slots_by_part(rig: CompiledRig) -> dict[str, list[int]]:
 
 def _legs(
     spec: CharacterSpec, rig: CompiledRig, by_part: dict[str, list[int]], phases: list[float]
-) -> list[dict[str, Any]]:
+) -> tuple[LegData, ...]:
     """Every leg part's two slots, rest joints, bone lengths, knee hint and hinge, reach and phase group."""
     slots = rig.slots
-    legs: list[dict[str, Any]] = []
+    legs: list[LegData] = []
     for part in spec.parts:
         if part.shape != "leg":
             continue
@@ -201,34 +216,30 @@ def _legs(
         reach = vq.normalize([foot[i] - hip[i] for i in range(3)])
         hinge = vq.normalize(vq.cross(reach, vq.gram_schmidt(unit_hint, reach)))
         legs.append(
-            {
-                "part": part.id,
-                "upper": upper,
-                "lower": lower,
-                "hip": hip,
-                "knee": knee,
-                "foot": foot,
-                "a": a,
-                "b": b,
-                "hint": unit_hint,
-                # The knee's rest hinge axis (normal of the hip-knee-foot plane): the slot frames' second
-                # axis, so the bones never twist as the leg swings (see motion/ik.py).
-                "hinge": hinge,
-                "group": phases.index(float(part.phase or 0.0)),
-                "reachMin": reach_min,
-                "reachMax": (a + b) * (1.0 - REACH_MARGIN),
-                # A hopper's foot at the apex: hip + (foot − hip)·tuck (a ratio, so an individual's size
-                # scales it with hip and foot; motion/hop.py hop_legs).
-                "tuck": (reach_min + HOP_TUCK * (drop - reach_min)) / drop,
-                "crouch": HOP_CROUCH_DEPTH,
-            }
+            LegData(
+                part=part.id,
+                upper=upper,
+                lower=lower,
+                hip=hip,
+                knee=knee,
+                foot=foot,
+                a=a,
+                b=b,
+                hint=_v(unit_hint),
+                hinge=_v(hinge),
+                group=phases.index(float(part.phase or 0.0)),
+                reach_min=reach_min,
+                reach_max=(a + b) * (1.0 - REACH_MARGIN),
+                tuck=(reach_min + HOP_TUCK * (drop - reach_min)) / drop,
+                crouch=HOP_CROUCH_DEPTH,
+            )
         )
-    return legs
+    return tuple(legs)
 
 
 def _ropes(
     spec: CharacterSpec, rig: CompiledRig, skeleton: Skeleton, by_part: dict[str, list[int]]
-) -> list[dict[str, Any]]:
+) -> tuple[RopeData, ...]:
     """Every rope part's chain of slots, rest nodes and radii, segment length and bend limit."""
     slots = rig.slots
     ropes = []
@@ -240,25 +251,23 @@ def _ropes(
         radius = [float(slots[s, col.RA]) for s in chain] + [float(slots[chain[-1], col.RB])]
         segment = math.dist(rest[0], rest[1])
         ropes.append(
-            {
-                "part": part.id,
-                "slots": chain,
-                "parent": skeleton.parent[chain[0]],
-                "rest": rest,
-                # The rest point one segment before the anchor, on the body: the bend limit's first reference.
-                "before": [2.0 * rest[0][i] - rest[1][i] for i in range(3)],
-                "radius": radius,
-                "segment": segment,
-                "bendMin": 2.0 * segment * math.cos(math.radians(ROPE_BEND_LIMIT_DEG) / 2.0),
-                # The follow-the-leader pass's cone (motion/ropes.py follow): cosine and sine of the limit.
-                "bendCos": math.cos(math.radians(ROPE_BEND_LIMIT_DEG)),
-                "bendSin": math.sin(math.radians(ROPE_BEND_LIMIT_DEG)),
-            }
+            RopeData(
+                part=part.id,
+                slots=tuple(chain),
+                parent=skeleton.parent[chain[0]],
+                rest=tuple(rest),
+                before=_v(2.0 * rest[0][i] - rest[1][i] for i in range(3)),
+                radius=tuple(radius),
+                segment=segment,
+                bend_min=2.0 * segment * math.cos(math.radians(ROPE_BEND_LIMIT_DEG) / 2.0),
+                bend_cos=math.cos(math.radians(ROPE_BEND_LIMIT_DEG)),
+                bend_sin=math.sin(math.radians(ROPE_BEND_LIMIT_DEG)),
+            )
         )
-    return ropes
+    return tuple(ropes)
 
 
-def _wings(spec: CharacterSpec, rig: CompiledRig, by_part: dict[str, list[int]]) -> list[dict[str, Any]]:
+def _wings(spec: CharacterSpec, rig: CompiledRig, by_part: dict[str, list[int]]) -> tuple[WingData, ...]:
     """Every flapping part's slot, flap side and amplitude, and length."""
     slots = rig.slots
     wings = []
@@ -268,61 +277,26 @@ def _wings(spec: CharacterSpec, rig: CompiledRig, by_part: dict[str, list[int]])
         (slot,) = by_part[part.id]
         start, end = _v(slots[slot, col.A]), _v(slots[slot, col.B])
         wings.append(
-            {
-                "part": part.id,
-                "slot": slot,
-                "sign": 1.0 if end[0] >= start[0] else -1.0,
-                "amplitude": float(part.flap),
-                "length": math.dist(start, end),
-            }
+            WingData(
+                part=part.id,
+                slot=slot,
+                sign=1.0 if end[0] >= start[0] else -1.0,
+                amplitude=float(part.flap),
+                length=math.dist(start, end),
+            )
         )
-    return wings
+    return tuple(wings)
 
 
-def _ground_and_step_limit(legs: list[dict[str, Any]], rig: CompiledRig) -> tuple[float, float]:
+def _ground_and_step_limit(legs: tuple[LegData, ...], rig: CompiledRig) -> tuple[float, float]:
     """The rest ground height (the legs' mean rest foot height, else the lowest point of any slot) and the
     cap on a step's lag (REACH_STEP_FRACTION of the shortest leg's horizontal reach at rest hip height, 0
     without legs)."""
     step_limit = 0.0
     if legs:
-        ground = sum(leg["foot"][1] for leg in legs) / len(legs)
-        horizontal = [
-            math.sqrt(max(leg["reachMax"] ** 2 - (leg["hip"][1] - ground) ** 2, 0.0)) for leg in legs
-        ]
+        ground = sum(leg.foot[1] for leg in legs) / len(legs)
+        horizontal = [math.sqrt(max(leg.reach_max**2 - (leg.hip[1] - ground) ** 2, 0.0)) for leg in legs]
         step_limit = REACH_STEP_FRACTION * min(horizontal)
     else:
         ground = float(min(min(s[1] - s[3], s[5] - s[7]) for s in rig.slots.tolist()))
     return ground, step_limit
-
-
-def _constants() -> dict[str, Any]:
-    """The stated constants the motion reads (this module's), shipped with the data."""
-    return {
-        "swingFroude": SWING_FROUDE,
-        "stepLead": STEP_LEAD,
-        "settleSlack": SETTLE_SLACK,
-        "hopCrouchS": HOP_CROUCH_S,
-        "hopLandS": HOP_LAND_S,
-        "hopSquash": HOP_SQUASH,
-        "hopStretch": HOP_STRETCH,
-        "strouhal": STROUHAL,
-        "swimResponse": SWIM_RESPONSE,
-        "ropeSubsteps": ROPE_SUBSTEPS,
-        "ropePasses": ROPE_PASSES,
-        "ropeDamping": ROPE_DAMPING,
-        "ropeBendLimitDeg": ROPE_BEND_LIMIT_DEG,
-    }
-
-
-def _plain(value: Any, place: str = "motion") -> Any:
-    """``value`` with every -0.0 made 0.0 (JSON writes -0 as 0; the two can differ downstream, e.g. in
-    atan2); a non-finite number is a build bug, named by its place."""
-    if isinstance(value, dict):
-        return {k: _plain(v, f"{place}.{k}") for k, v in value.items()}
-    if isinstance(value, list):
-        return [_plain(v, f"{place}[{i}]") for i, v in enumerate(value)]
-    if isinstance(value, float):
-        if not math.isfinite(value):
-            raise ValueError(f"{place}: {value} is not a finite number")
-        return value + 0.0
-    return value

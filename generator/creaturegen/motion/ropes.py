@@ -10,25 +10,25 @@ cone. The rope's slots are posed by parallel transport down the chain.
 from __future__ import annotations
 
 import math
-from typing import Any
 
 from . import quat as vq
+from .data import RopeData
 from .providers import Frame, to_local, to_world
-from .quat import Vec
+from .quat import Point, Vec
 from .root import to_local_root, to_world_root
 from .state import MotionState
 
 
-def body_point(quats: list[list[float]], trans: list[Vec], slot: int, x: Vec) -> Vec:
+def body_point(quats: list[list[float]], trans: list[Vec], slot: int, x: Point) -> Vec:
     """Rest point ``x`` moved rigidly with ``slot`` (creature-local)."""
     q, t = quats[slot], trans[slot]
     r = vq.rotate(q, x)
     return [r[0] + t[0], r[1] + t[1], r[2] + t[2]]
 
 
-def anchor_point(quats: list[list[float]], trans: list[Vec], rope: dict[str, Any], j: int) -> Vec:
+def anchor_point(quats: list[list[float]], trans: list[Vec], rope: RopeData, j: int) -> Vec:
     """Rest point ``j`` of the rope moved rigidly with its parent slot (creature-local)."""
-    return body_point(quats, trans, rope["parent"], rope["rest"][j])
+    return body_point(quats, trans, rope.parent, rope.rest[j])
 
 
 def bend(cur: list[Vec], before: Vec, bend_min: float) -> None:
@@ -50,12 +50,12 @@ def bend(cur: list[Vec], before: Vec, bend_min: float) -> None:
             cur[j + 1] = [b[0] - dx * hf, b[1] - dy * hf, b[2] - dz * hf]
 
 
-def follow(cur: list[Vec], before: Vec, rope: dict[str, Any], frame: Frame, ground: bool) -> None:
+def follow(cur: list[Vec], before: Vec, rope: RopeData, frame: Frame, ground: bool) -> None:
     """Follow the leader from the anchor: each segment its rest length and within the bend limit of the
     one before (the first of the body's direction into the anchor), and above the support where
     ``ground``. Relaxation passes alone leave a whipped tail stretched and bent past its limit; the skin
     is certified for the poses this bounds (motion/envelope.py)."""
-    seg, c_max, s_max, radius = rope["segment"], rope["bendCos"], rope["bendSin"], rope["radius"]
+    seg, c_max, s_max, radius = rope.segment, rope.bend_cos, rope.bend_sin, rope.radius
     a = cur[0]
     px, py, pz = a[0] - before[0], a[1] - before[1], a[2] - before[2]
     n = math.sqrt(px * px + py * py + pz * pz)
@@ -108,9 +108,9 @@ def rest_nodes(m: MotionState) -> None:
     """Every rope's nodes where its rest pose puts them on the posed body, not moving (the previous
     nodes the same): the ropes at reset."""
     m.nodes, m.prev_nodes = [], []
-    for rope in m.data["ropes"]:
+    for rope in m.data.ropes:
         world = [
-            to_world_root(m.root, anchor_point(m.quats, m.trans, rope, j)) for j in range(len(rope["rest"]))
+            to_world_root(m.root, anchor_point(m.quats, m.trans, rope, j)) for j in range(len(rope.rest))
         ]
         m.nodes.append(world)
         m.prev_nodes.append([list(x) for x in world])
@@ -119,21 +119,21 @@ def rest_nodes(m: MotionState) -> None:
 def step_ropes(m: MotionState, frame: Frame, integrate: bool) -> None:
     """The ropes' stage of one tick: integrate (unless at reset, where they start at rest), then pose the
     rope slots from the nodes."""
-    d, c = m.d, m.data["constants"]
+    d, c = m.d, m.data.constants
     if not integrate:
         rest_nodes(m)
     g = m.gravity0 if getattr(m.gravity, "constant", False) else m.gravity.at(m.tick * d.dt)
-    substeps, passes, keep = c["ropeSubsteps"], c["ropePasses"], 1.0 - c["ropeDamping"]
+    substeps, passes, keep = c.rope_substeps, c.rope_passes, 1.0 - c.rope_damping
     h = d.dt / substeps
     gx, gy, gz = g[0] * h * h, g[1] * h * h, g[2] * h * h
-    ground = m.data["ropeGround"]
+    ground = m.data.rope_ground
     f0, f1, f2, n0, n1, n2 = frame[0], frame[1], frame[2], frame[6], frame[7], frame[8]
-    for index, rope in enumerate(m.data["ropes"]):
+    for index, rope in enumerate(m.data.ropes):
         cur, prev = m.nodes[index], m.prev_nodes[index]
         anchor_local = anchor_point(m.quats, m.trans, rope, 0)
         anchor = to_world_root(m.root, anchor_local)
-        seg, bend_min, radius = rope["segment"], rope["bendMin"], rope["radius"]
-        before = to_world_root(m.root, body_point(m.quats, m.trans, rope["parent"], rope["before"]))
+        seg, bend_min, radius = rope.segment, rope.bend_min, rope.radius
+        before = to_world_root(m.root, body_point(m.quats, m.trans, rope.parent, rope.before))
         if integrate:
             for _ in range(substeps):
                 cur[0], prev[0] = list(anchor), list(anchor)
@@ -167,25 +167,25 @@ def step_ropes(m: MotionState, frame: Frame, integrate: bool) -> None:
         pose_rope(m, rope, cur, anchor_local)
 
 
-def pose_rope(m: MotionState, rope: dict[str, Any], cur: list[Vec], anchor_local: Vec) -> None:
+def pose_rope(m: MotionState, rope: RopeData, cur: list[Vec], anchor_local: Vec) -> None:
     """The rope's slots from its world nodes ``cur``, and the anchor gate (the posed anchor of segment 0
     against ``anchor_local``, the body's)."""
     local = [to_local_root(m.root, x) for x in cur]
-    rest = rope["rest"]
+    rest = rope.rest
     # Segment frames by parallel transport down the chain (each turns by the bend from the one
     # before; the first from the parent's), so the twist is continuous and the shortest-arc turn
     # stays far from its ill-conditioned half-turn even when the tail whips past its rest direction.
-    prev_q = m.quats[rope["parent"]]
+    prev_q = m.quats[rope.parent]
     prev_dir = vq.rotate(prev_q, vq.normalize([rest[1][k] - rest[0][k] for k in range(3)]))
-    for j, slot in enumerate(rope["slots"]):
+    for j, slot in enumerate(rope.slots):
         e1 = vq.normalize([local[j + 1][k] - local[j][k] for k in range(3)])
         q = vq.mul(vq.from_to(prev_dir, e1), prev_q)
         prev_q, prev_dir = q, e1
         r = vq.rotate(q, rest[j])
         m.quats[slot] = q
         m.trans[slot] = [local[j][0] - r[0], local[j][1] - r[1], local[j][2] - r[2]]
-    r0 = vq.rotate(m.quats[rope["slots"][0]], rest[0])
-    t0 = m.trans[rope["slots"][0]]
+    r0 = vq.rotate(m.quats[rope.slots[0]], rest[0])
+    t0 = m.trans[rope.slots[0]]
     posed = [r0[0] + t0[0], r0[1] + t0[1], r0[2] + t0[2]]
-    body = m.data["bodyScale"]
+    body = m.data.body_scale
     m.gates.rope_anchor = max(m.gates.rope_anchor, vq.distance(posed, anchor_local) / body)

@@ -18,14 +18,15 @@ tick n is reached only by stepping from tick 0, so ``seek_tick(n)`` (reset, then
 from __future__ import annotations
 
 import struct
-from typing import Any
 
-from ..model.genome import Genome, draw_genome, express, individual_size
+from ..model.genome import Genome, draw_genome
 from ..model.lcg import instance_yaw
 from ..model.trig import pcos, psin
 from . import quat as vq
 from .base_pose import base_pose
+from .data import MotionData
 from .derived import derive
+from .express import express, individual_size
 from .gait import walk
 from .hop import hop_at, hop_gates, hop_legs
 from .providers import SWIMMER_CHANNELS, AnalyticWater, FlatGround, Frame, Gravity, Support
@@ -45,7 +46,7 @@ class Motion(MotionState):
 
     def __init__(
         self,
-        data: dict[str, Any],
+        data: MotionData,
         *,
         support: Support | None = None,
         gravity: Gravity | None = None,
@@ -59,7 +60,7 @@ class Motion(MotionState):
         genes = genome if genome is not None else draw_genome(seed)
         self.size = individual_size(data, genes)
         self.data = express(data, genes)
-        self.kind = str(data["type"])
+        self.kind = data.type
         self.support = support or FlatGround()
         self.gravity = gravity or Gravity()
         self.water = water
@@ -74,26 +75,26 @@ class Motion(MotionState):
         yaw = instance_yaw(seed)
         self.theta0 = -yaw
         self.position = [float(c) for c in position]
-        self.slot_count = len(data["parent"])
+        self.slot_count = len(data.parent)
         self.rest_pose = None
         self.reset()
 
     # --- state -----------------------------------------------------------------------------------
 
     def reset(self) -> None:
-        radius = self.data["pathRadius"]
+        radius = self.data.path_radius
         self.centre = [
             self.position[0] - radius * pcos(self.theta0),
             self.position[1],
             self.position[2] - radius * psin(self.theta0),
         ]
         self.tick = 0
-        self.feet = [Foot() for _ in self.data["legs"]]
+        self.feet = [Foot() for _ in self.data.legs]
         self.nodes = []
         self.prev_nodes = []
         self.swim_y = 0.0
         self.swim_vy = 0.0
-        self.gates = Gates(fewest_planted=len(self.data["legs"]))
+        self.gates = Gates(fewest_planted=len(self.data.legs))
         self.quats = [list(vq.IDENTITY) for _ in range(self.slot_count)]
         self.trans = [[0.0, 0.0, 0.0] for _ in range(self.slot_count)]
         self.root = [0.0, 0.0, 0.0, 1.0, 0.0, 1.0]  # position, cos yaw, sin yaw, squash
@@ -119,17 +120,17 @@ class Motion(MotionState):
         frame = self.support.frame(time)
         data = self.data
         if self.kind in WALKERS:
-            u, w, psi = path(self, data["speed"] * time)
+            u, w, psi = path(self, data.speed * time)
             return frame, grounded(data, frame, u, w, psi, 0.0, 1.0)
         if self.kind == "hopper":
             dist, lift, squash = hop_at(data, self.d, n)
             u, w, psi = path(self, dist)
             return frame, grounded(data, frame, u, w, psi, lift, squash)
         if self.kind == "flyer":
-            u, w, psi = path(self, data["speed"] * time)
-            return frame, [u, data["altitude"] - data["groundY"], w, pcos(psi), psin(psi), 1.0]
+            u, w, psi = path(self, data.speed * time)
+            return frame, [u, data.altitude - data.ground_y, w, pcos(psi), psin(psi), 1.0]
         if self.kind == "swimmer":
-            u, w, psi = path(self, data["speed"] * time)
+            u, w, psi = path(self, data.speed * time)
             return frame, [u, self.swim_y, w, pcos(psi), psin(psi), 1.0]
         return frame, grounded(data, frame, self.position[0], self.position[2], -self.theta0, 0.0, 1.0)
 
@@ -142,12 +143,12 @@ class Motion(MotionState):
         if self.kind == "hopper":
             hop_gates(self, n, root)
         base_pose(self, time)
-        if self.data["legs"]:
+        if self.data.legs:
             if self.kind == "hopper":
                 hop_legs(self, n, frame, integrate)
             else:
                 walk(self, n, frame, integrate)
-        if self.data["ropes"]:
+        if self.data.ropes:
             step_ropes(self, frame, integrate)
 
     # --- output ----------------------------------------------------------------------------------

@@ -3,16 +3,17 @@ its feet and ropes, and the gates measured on them.
 
 simulate.py's ``Motion`` owns this state and composes the stages that write it (root.py, base_pose.py,
 gait.py, hop.py, flight.py, swim.py, ropes.py); each stage is a function of the state, so it reads as its
-own concept, as core/motion/motion.js reads. The state is stateful by nature: feet, ropes and the swimmer
-integrate, so the state at tick n is reached only by stepping from tick 0.
+own concept, as the JS core does (core/motion/state.js and one module per stage). The state is stateful
+by nature: feet, ropes and the swimmer integrate, so the state at tick n is reached only by stepping from
+tick 0.
 """
 
 from __future__ import annotations
 
 from abc import ABC, abstractmethod
 from dataclasses import dataclass, field
-from typing import Any
 
+from .data import MotionData
 from .derived import Derived
 from .providers import AnalyticWater, Frame, Gravity, Support
 from .quat import Vec
@@ -47,7 +48,7 @@ class Gates:
     apex_squash: float = 1.0
     squash_det: float = 0.0  # max |sx·sy·sz − 1|
 
-    def as_dict(self) -> dict[str, Any]:
+    def as_dict(self) -> dict[str, float]:
         return dict(self.__dict__)
 
 
@@ -57,7 +58,7 @@ class MotionState(ABC):
     # The individual: its size factor, its motion data (the authored data expressed by its genes), its
     # locomotion type, the numbers derived from the data and the gravity at spawn.
     size: float
-    data: dict[str, Any]
+    data: MotionData
     kind: str
     d: Derived
     # The injected providers, and gravity at time 0.

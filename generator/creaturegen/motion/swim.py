@@ -9,10 +9,11 @@ centre. Stage 2 (the base pose): an undulation about Y at every skeleton root, a
 from __future__ import annotations
 
 import math
-from typing import Any, Final
+from typing import Final
 
 from ..model.trig import psin
 from . import quat as vq
+from .data import MotionData
 from .derived import Derived
 from .root import path
 from .state import MotionState
@@ -25,11 +26,11 @@ def follow_surface(m: MotionState, n: int, integrate: bool) -> None:
     drift of its path, and the tracking gate after 2 s."""
     d, data = m.d, m.data
     time = n * d.dt
-    u, w, _ = path(m, data["speed"] * time)
+    u, w, _ = path(m, data.speed * time)
     assert m.water is not None
     sample = m.water.sample(u, w, time)
     eta = sample["freeSurfacePoint"][1]
-    target = eta - d.swim_depth - data["centreY"]
+    target = eta - d.swim_depth - data.centre_y
     target_v = sample["geometricNormalVelocityMps"][0] / sample["freeSurfaceNormal"][1]
     if not integrate:
         m.swim_y, m.swim_vy = target, target_v
@@ -46,10 +47,10 @@ def follow_surface(m: MotionState, n: int, integrate: bool) -> None:
         m.gates.swim_tracking = max(m.gates.swim_tracking, abs(m.swim_y - target))
 
 
-def undulation_locals(data: dict[str, Any], d: Derived, time: float) -> dict[int, list[float]]:
+def undulation_locals(data: MotionData, d: Derived, time: float) -> dict[int, list[float]]:
     """Slot → local rotation of a swimmer at ``time``: its undulation at the roots."""
     locals_: dict[int, list[float]] = {}
-    angle = data["undulation"] * psin(2.0 * math.pi * d.undulation_hz * time)
-    for r in data["roots"]:
+    angle = data.undulation * psin(2.0 * math.pi * d.undulation_hz * time)
+    for r in data.roots:
         locals_[r] = vq.axis_angle(Y_AXIS, angle)
     return locals_

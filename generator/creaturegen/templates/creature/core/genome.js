@@ -1,8 +1,8 @@
 // Genomes: what makes one spawned individual differ from another, drawn from its seed by the LCG, the same
-// scalar arithmetic in the same order as creaturegen's Python reference (model/genome.py), so the two
-// agree bit for bit. Genes are signed draws in [-1, 1) of the stream from mixSeed(seed): draw 1 is
-// reserved, draw 2 is the heading (instanceYaw), draws 3, 4, 5 are hue, chroma and lightness, draws 6, 7, 8
-// the gait genes, draw 9 the size.
+// scalar arithmetic in the same order as creaturegen's Python reference (model/genome.py, and
+// motion/express.py for the motion data), so the two agree bit for bit. Genes are signed draws in [-1, 1) of
+// the stream from mixSeed(seed): draw 1 is reserved, draw 2 is the heading (instanceYaw), draws 3, 4, 5 are
+// hue, chroma and lightness, draws 6, 7, 8 the gait genes, draw 9 the size.
 //
 // Size is a similarity of the certified body (the only morphology a spawn carries): its rest geometry
 // (pose.js writePoseRows, tsl/body.js) and every motion length (expressSize) scale by 1 + size·gene, so

@@ -1,0 +1,95 @@
+"""CREATURE as a typed record: every number the package's runtime reads, which core/data.js ships.
+
+creature/plan.py builds it; its JSON (model/record.py ``to_json``) is the plan's ``runtime`` and the text of
+core/data.js, key for key as the untyped dict it replaced. core/index.d.ts declares its interfaces by
+rendering these classes (emit/tstypes.py), the motion data's included (motion/data.py), so the shipped
+declarations are the shipped data's, field for field; the attribute docstrings become their comments.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from functools import cache
+from typing import Annotated
+
+from ..emit.tstypes import declarations
+from ..model.genome import ColourGenetics
+from ..model.lcg import Lcg
+from ..model.record import JsonRecord, TsName
+from ..motion.data import MotionData, Vec3
+
+
+@dataclass(frozen=True, slots=True)
+class CorrectionData(JsonRecord):
+    """The local correction of the skinned surface toward the field's iso level (surface/correct.py)."""
+
+    budget: int
+    """Shared trial budget per vertex."""
+    early_out: float
+    """A vertex within this fraction of its trust radius of the iso level stops spending trials."""
+    gradient_floor: float
+    """Squared-gradient floor below which a vertex has no usable Newton direction."""
+
+
+@dataclass(frozen=True, slots=True)
+class MeshCounts(JsonRecord):
+    """The reference surface's size."""
+
+    vertices: int
+    triangles: int
+
+
+@dataclass(frozen=True, slots=True)
+class CreatureData(JsonRecord):
+    """CREATURE: the build plan of this creature, as data (core/data.js)."""
+
+    name: str
+    slug: str
+    """The npm package name."""
+    version: str
+    """creaturegen version that built the package."""
+    spec_sha256: str
+    signatures: Annotated[dict[str, str], TsName("CreatureSignatures")]
+    tier: Annotated[str, TsName("TierName")]
+    surface_file: str
+    """The reference surface's file name in assets/ (``new URL(surfaceFile, assetBase)`` when assetBase is
+    given)."""
+    three_revision: str
+    """three.js REVISION the package was built for ('185')."""
+    body_scale: float
+    slot_count: int
+    max_parts: int
+    """Pose-texture parts per instance: every slot, and one for the root rows."""
+    pose_rows: int
+    slots: tuple[tuple[float, ...], ...]
+    """Rest slot table, one row of 12 numbers per slot."""
+    slot_names: tuple[str, ...]
+    round_cone: tuple[int, ...]
+    lcg: Lcg
+    genetics: ColourGenetics
+    slot_lab: tuple[Vec3, ...]
+    """OKLab coordinates of every slot's authored colour, which the colour genes mutate."""
+    motion: MotionData
+    tick_rate: int
+    program_data: tuple[float, ...]
+    program_count: int
+    full_program: int
+    no_program: int
+    skin_program: int
+    """The candidate code of a vertex that evaluates no field (a skin-represented tier): skinned position
+    and normal, baked colour."""
+    registers: int
+    candidate_note: str
+    gradient_floor: float
+    tiny: float
+    k_floor: float
+    correction: CorrectionData
+    mesh: MeshCounts
+    debug_modes: tuple[Annotated[str, TsName("DebugMode")], ...]
+    deform_stride: int
+
+
+@cache
+def data_declarations() -> str:
+    """core/index.d.ts's interfaces of CREATURE and every record it holds (the plan's ``types``)."""
+    return declarations(CreatureData)
