@@ -134,14 +134,20 @@ def _failures(
 
 def _planted(package: Path, tmp_path: Path, file: str, swaps: list[tuple[str, str]]) -> Path:
     """A copy of the package with a wrong GPU formula (the Python reference is untouched)."""
+    return _planted_files(package, tmp_path, {file: swaps})
+
+
+def _planted_files(package: Path, tmp_path: Path, plants: dict[str, list[tuple[str, str]]]) -> Path:
+    """``_planted`` over several files of ``tsl/`` (a defect that spans modules)."""
     copy = tmp_path / package.name
     shutil.copytree(package, copy)
-    path = copy / "tsl" / file
-    text = path.read_text()
-    for old, new in swaps:
-        assert old in text, f"the planted error no longer applies: {old!r} not in {file}"
-        text = text.replace(old, new)
-    path.write_text(text)
+    for file, swaps in plants.items():
+        path = copy / "tsl" / file
+        text = path.read_text()
+        for old, new in swaps:
+            assert old in text, f"the planted error no longer applies: {old!r} not in {file}"
+            text = text.replace(old, new)
+        path.write_text(text)
     return copy
 
 
@@ -234,11 +240,11 @@ def test_the_job_catches_a_population_that_uploads_a_stale_pose(out_root: Path, 
     planted = _planted(
         package,
         tmp_path,
-        "population.js",
+        "staging.js",
         [
             (
-                "writeInstance(page, j, m.quats, m.trans, m.root);",
-                "writeInstance(page, j, m.prevQuats, m.prevTrans, m.root);",
+                "writeInstance(state, page, j, m.quats, m.trans, m.root);",
+                "writeInstance(state, page, j, m.prevQuats, m.prevTrans, m.root);",
             )
         ],
     )
@@ -377,21 +383,23 @@ def test_the_job_catches_a_page_drawn_twice_in_a_pass(out_root: Path, tmp_path: 
     in use right but draws each page twice in the display pass: the draws-beyond-pages gate fails, and
     the pages-in-use gate stays quiet (the defect is in the draws, not in where bodies go)."""
     twin = (
-        "    page.mesh.material = materialFor(page, m);\n",
-        "    page.mesh.material = materialFor(page, m);\n"
-        "    if (!page.twin) {\n"
-        "      page.twin = new THREE.Mesh(geometry, null);\n"
-        "      page.twin.boundingSphere = page.mesh.boundingSphere;\n"
-        "      group.add(page.twin);\n"
-        "    }\n"
-        "    page.twin.material = page.mesh.material;\n",
+        "  page.mesh.material = materialFor(state, page, m);\n",
+        "  page.mesh.material = materialFor(state, page, m);\n"
+        "  if (!page.twin) {\n"
+        "    page.twin = new THREE.Mesh(state.geometry, null);\n"
+        "    page.twin.boundingSphere = page.mesh.boundingSphere;\n"
+        "    group.add(page.twin);\n"
+        "  }\n"
+        "  page.twin.material = page.mesh.material;\n",
     )
     count = (
-        "    page.mesh.count = last + 1;\n",
-        "    page.mesh.count = last + 1;\n    if (page.twin) page.twin.count = page.mesh.count;\n",
+        "  page.mesh.count = last + 1;\n",
+        "  page.mesh.count = last + 1;\n  if (page.twin) page.twin.count = page.mesh.count;\n",
     )
     package = build("reference/hopper.json", out_root)
-    failed, summary = _failures(package, tmp_path, "population.js", [twin, count], ("population",))
+    planted = _planted_files(package, tmp_path, {"pages.js": [twin], "staging.js": [count]})
+    report = run_creature_parity(planted, groups=("population",))
+    failed, summary = {g["name"] for g in report.gates if g["status"] == "fail"}, report.summary()
     assert "body draw calls in a render pass beyond pages in use (encoder count)" in failed, summary
     assert f"pose pages in use after {SPAWNS} spawns of pageSize {PAGE_SIZE}" not in failed, summary
 

@@ -1,6 +1,6 @@
-// A population of one creature: fixed-capacity pose pages (vec4 storage, CPU Float32Array staging),
-// one deform pre-pass, one material and one draw per page, coalesced dirty-range uploads, posed bounds
-// per page. Every body is driven by its own locomotion core (core/motion/motion.js) on the population's
+// A population of one creature: fixed-capacity pose pages (vec4 storage, CPU Float32Array staging; pages.js),
+// one deform pre-pass, one material and one draw per page, coalesced dirty-range uploads and posed bounds
+// per page (staging.js). Every body is driven by its own locomotion core (core/motion/motion.js) on the population's
 // support, gravity and water providers; the pose rows are what that core computed. Nothing GPU-side is
 // created after warm(): pages, deform storage, materials and pipelines (compute, display, shadow) are
 // built and warmed up front; a spawn validates, builds the body's CPU motion state and writes O(slots).
@@ -12,16 +12,14 @@ import { GENOME_LENGTH, drawGenome, genomeColours } from '../core/genome.js';
 import { createDriver } from '../core/motion/driver.js';
 import { assertWaterFor, createMotion } from '../core/motion/motion.js';
 import { createFlatGround, createGravity } from '../core/motion/providers.js';
-import { rootBounds, writePoseRows, writeRootRows } from '../core/pose.js';
 import { checkThreeRevision, loadSurface, resolveSurfaceUrl } from '../core/surface.js';
 import { defaultSurfaceUrl } from './asset.js';
-import { bodyFunctions, layoutOf } from './body.js';
-import {
-  DEFORM_STRIDE, createDeformKernel, deformStorage, deformView, dispatchDeform, vertexRecords,
-} from './deform.js';
-import { checkDebugMode, createBodyMaterial } from './material.js';
+import { layoutOf } from './body.js';
+import { DEFORM_STRIDE, dispatchDeform, vertexRecords } from './deform.js';
 import { registerInternals } from './internals.js';
-import { createShellMesh } from './shell.js';
+import { checkDebugMode } from './material.js';
+import { createPages, kernelKind, showMode } from './pages.js';
+import { advance, deformRange, flush, locate, writeCurrent, writeInstance } from './staging.js';
 
 const SHIPPED_VARIANTS = ['off'];
 
@@ -110,164 +108,34 @@ export async function createCreaturePopulation(renderer, options = {}) {
   const floatsPerInstance = data.maxParts * data.poseRows * 4;
   const group = new THREE.Group();
   group.name = data.slug;
-  const variants = new Map();
-  const stats = {
-    uploads: 0, uploadBytes: 0, lastFrameBytes: 0, spawns: 0, ticks: 0, deformDispatches: 0, lastFrameDeformedVertices: 0,
+  const state = {
+    renderer, data, capacity, pageSize, floatsPerInstance, layout, programs, records, vertices, geometry, group,
+    variants: new Map(),
+    stats: {
+      uploads: 0, uploadBytes: 0, lastFrameBytes: 0, spawns: 0, ticks: 0, deformDispatches: 0, lastFrameDeformedVertices: 0,
+    },
+    pages: null,
+    rootRow: data.slotCount * data.poseRows * 4,
+    // Scratch for writing rows and bounds, reused by every body every frame.
+    scratch: { tmp: new Float64Array(3), localBox: new Float64Array(6), corner: new THREE.Vector3(), box: new THREE.Box3() },
+    tick: 0,
+    mode: checkDebugMode(options.debugMode ?? 'off'),
   };
-
-  const pages = [];
-  for (let first = 0; first < capacity; first += pageSize) {
-    const size = Math.min(pageSize, capacity - first);
-    const pose = instancedArray(new Float32Array(size * floatsPerInstance), 'vec4');
-    const mesh = new THREE.Mesh(geometry, null);
-    mesh.count = 0;
-    mesh.castShadow = true;
-    mesh.receiveShadow = true;
-    mesh.boundingSphere = new THREE.Sphere(new THREE.Vector3(), 0);
-    mesh.name = `${data.slug}.page${pages.length}`;
-    group.add(mesh);
-    const deform = deformStorage(size, vertices);
-    pages.push({
-      first, size, pose, mesh, staging: pose.value.array, deform, deformView: deformView(deform), kernels: new Map(), shell: null,
-      alive: new Uint8Array(size), seed: new Uint32Array(size), spawnTick: new Float64Array(size),
-      motions: new Array(size).fill(null), bounds: new Float64Array(6 * size),
-      genomes: new Float64Array(GENOME_LENGTH * size), colours: new Float64Array(3 * data.slotCount * size),
-      dirtyLo: Infinity, dirtyHi: -1,
-    });
-  }
-  const rootRow = data.slotCount * data.poseRows * 4;
-  const tmp = new Float64Array(3);
-  const localBox = new Float64Array(6);
-  const renderQuats = new Float64Array(4 * data.slotCount);
-  const renderTrans = new Float64Array(3 * data.slotCount);
-  const renderRoot = new Float64Array(6);
+  const pages = createPages(state);
+  state.pages = pages;
+  const { stats, variants } = state;
+  // The render pose of one body (update() interpolates every body into these, then writes its rows).
+  const render = {
+    quats: new Float64Array(4 * data.slotCount), trans: new Float64Array(3 * data.slotCount), root: new Float64Array(6),
+  };
   const driver = createDriver(data.tickRate);
-  const corner = new THREE.Vector3();
-  const box = new THREE.Box3();
-  let tick = 0;
-  let mode = checkDebugMode(options.debugMode ?? 'off');
-
-  const variantKey = (m) => [data.signatures.compilerSignature, data.signatures.topologySignature, data.tier, m, data.registers].join('|');
-  function materialFor(page, m) {
-    const key = `${variantKey(m === 'shell' ? 'off' : m)}|page${pages.indexOf(page)}`;
-    if (!variants.has(key)) variants.set(key, createBodyMaterial(layout, page.pose, page.deformView, m === 'shell' ? 'off' : m));
-    return variants.get(key);
-  }
-  // The pre-pass variant of a mode: 'skin-only' stores uncorrected positions, every other mode the body.
-  const kernelKind = (m) => (m === 'skin-only' ? 'skin-only' : 'body');
-  function kernelFor(page, kind) {
-    if (!page.kernels.has(kind)) {
-      const fns = bodyFunctions(layout, page.pose, programs);
-      page.kernels.set(kind, createDeformKernel(layout, fns, {
-        pose: page.pose, records, deform: page.deform, size: page.size, vertices, skinOnly: kind === 'skin-only',
-      }));
-    }
-    return page.kernels.get(kind);
-  }
-  function showMode(page, m) {
-    page.mesh.material = materialFor(page, m);
-    page.kernel = kernelFor(page, kernelKind(m));
-    if (m === 'shell' && !page.shell) {
-      page.shell = createShellMesh(layout, page.pose, page.mesh.name);
-      page.shell.boundingSphere = page.mesh.boundingSphere;
-      group.add(page.shell);
-    }
-    page.mesh.visible = m !== 'shell';
-    if (page.shell) {
-      page.shell.visible = m === 'shell';
-      page.shell.count = page.mesh.count * data.slotCount;
-    }
-  }
-  for (const page of pages) showMode(page, mode);
-
-  // One body's rows from per-slot transforms and a root (the motion's current step, or its render pose),
-  // and its world bounds; marks the instance dirty for the next flush.
-  function writeInstance(page, j, quats, trans, root) {
-    const base = j * floatsPerInstance;
-    const size = page.motions[j].size;
-    writePoseRows(data, quats, trans, page.colours, 3 * data.slotCount * j, tmp, page.staging, base, localBox, size);
-    writeRootRows(root, page.alive[j], page.staging, base + rootRow, size);
-    rootBounds(localBox, root, page.bounds, 6 * j);
-    page.dirtyLo = Math.min(page.dirtyLo, j);
-    page.dirtyHi = Math.max(page.dirtyHi, j);
-  }
-  function writeCurrent(page, j) {
-    const m = page.motions[j];
-    writeInstance(page, j, m.quats, m.trans, m.root);
-  }
-
-  function refreshBounds(page) {
-    box.makeEmpty();
-    let last = -1;
-    for (let j = 0; j < page.size; j++) {
-      if (!page.alive[j]) continue;
-      last = j;
-      const b = page.bounds;
-      box.expandByPoint(corner.set(b[6 * j], b[6 * j + 1], b[6 * j + 2]));
-      box.expandByPoint(corner.set(b[6 * j + 3], b[6 * j + 4], b[6 * j + 5]));
-    }
-    page.mesh.count = last + 1;
-    if (page.shell) page.shell.count = page.mesh.count * data.slotCount;
-    if (last < 0) page.mesh.boundingSphere.set(page.mesh.boundingSphere.center.set(0, 0, 0), 0);
-    else box.getBoundingSphere(page.mesh.boundingSphere);
-  }
-
-  // The pre-pass over instances lo..hi of a page, clipped to the drawn range (dead ones are skipped).
-  function deformRange(page, lo, hi) {
-    const top = Math.min(hi, page.mesh.count - 1);
-    if (top < lo) return 0;
-    stats.deformDispatches += 1;
-    return dispatchDeform(renderer, page.kernel, lo, top);
-  }
-
-  // One coalesced range per page: [first dirty instance, last dirty instance], uploaded once per flush,
-  // then that range deformed once (the upload rides on the dispatch's binding update).
-  function flush() {
-    let bytes = 0;
-    let deformed = 0;
-    for (const page of pages) {
-      if (page.dirtyHi < 0) continue;
-      const start = page.dirtyLo * floatsPerInstance;
-      const count = (page.dirtyHi - page.dirtyLo + 1) * floatsPerInstance;
-      page.pose.value.addUpdateRange(start, count);
-      page.pose.value.needsUpdate = true;
-      bytes += 4 * count;
-      refreshBounds(page);
-      deformed += deformRange(page, page.dirtyLo, page.dirtyHi);
-      page.dirtyLo = Infinity;
-      page.dirtyHi = -1;
-    }
-    stats.lastFrameDeformedVertices = deformed;
-    stats.lastFrameBytes = bytes;
-    stats.uploadBytes += bytes;
-    if (bytes) stats.uploads += 1;
-    return bytes;
-  }
-
-  function locate(id) {
-    if (!Number.isInteger(id) || id < 0 || id >= capacity) throw new Error(`id: ${id} is not an instance of this population (0..${capacity - 1})`);
-    const page = pages[Math.floor(id / pageSize)];
-    return { page, j: id - page.first };
-  }
-
-  // Every live body `n` fixed steps on (stepTicks and update share it: same ticks, same state).
-  function advance(n) {
-    for (const page of pages) {
-      for (let j = 0; j < page.size; j++) {
-        if (!page.alive[j]) continue;
-        const m = page.motions[j];
-        for (let k = 0; k < n; k++) m.step();
-      }
-    }
-    tick += n;
-    stats.ticks += n;
-  }
+  for (const page of pages) showMode(state, page, state.mode);
 
   const population = {
     object3d: group,
     pages,
-    get tick() { return tick; },
-    get debugMode() { return mode; },
+    get tick() { return state.tick; },
+    get debugMode() { return state.mode; },
     get capacity() { return capacity; },
     /** Bodies per page (one draw each): the requested size, clamped to what one storage binding holds. */
     get pageSize() { return pageSize; },
@@ -298,8 +166,8 @@ export async function createCreaturePopulation(renderer, options = {}) {
           genomeColours(data, genome, page.colours, 3 * data.slotCount * j);
           page.alive[j] = 1;
           page.seed[j] = seed;
-          page.spawnTick[j] = tick;
-          writeCurrent(page, j);
+          page.spawnTick[j] = state.tick;
+          writeCurrent(state, page, j);
           stats.spawns += 1;
           return page.first + j;
         }
@@ -307,7 +175,7 @@ export async function createCreaturePopulation(renderer, options = {}) {
       throw new Error(`spawn: the population is full (capacity ${capacity}); create it with a larger capacity`);
     },
     despawn(id) {
-      const { page, j } = locate(id);
+      const { page, j } = locate(state, id);
       page.alive[j] = 0;
       page.motions[j] = null;
       page.genomes.fill(0, GENOME_LENGTH * j, GENOME_LENGTH * (j + 1));
@@ -319,9 +187,9 @@ export async function createCreaturePopulation(renderer, options = {}) {
     /** Advance every body `n` whole fixed steps and upload the current step's pose (no interpolation). */
     stepTicks(n = 1) {
       if (!Number.isInteger(n) || n < 0) throw new Error(`stepTicks: a non-negative integer (got ${n})`);
-      advance(n);
-      for (const page of pages) for (let j = 0; j < page.size; j++) if (page.alive[j]) writeCurrent(page, j);
-      return flush();
+      advance(state, n);
+      for (const page of pages) for (let j = 0; j < page.size; j++) if (page.alive[j]) writeCurrent(state, page, j);
+      return flush(state);
     },
     /**
      * Put the population at tick `n`: each body re-simulated from its spawn to its own tick
@@ -333,12 +201,12 @@ export async function createCreaturePopulation(renderer, options = {}) {
         for (let j = 0; j < page.size; j++) {
           if (!page.alive[j]) continue;
           page.motions[j].seekTick(Math.max(0, n - page.spawnTick[j]));
-          writeCurrent(page, j);
+          writeCurrent(state, page, j);
         }
       }
-      tick = n;
+      state.tick = n;
       driver.reset();
-      return flush();
+      return flush(state);
     },
     /**
      * One render frame of `dt` seconds: the fixed-step driver (dt clamped to [0, 0.25] s, accumulator
@@ -347,23 +215,23 @@ export async function createCreaturePopulation(renderer, options = {}) {
      */
     update(dt) {
       const steps = driver.advance(dt);
-      advance(steps);
+      advance(state, steps);
       for (const page of pages) {
         for (let j = 0; j < page.size; j++) {
           if (!page.alive[j]) continue;
-          page.motions[j].renderPose(driver.alpha, renderQuats, renderTrans, renderRoot);
-          writeInstance(page, j, renderQuats, renderTrans, renderRoot);
+          page.motions[j].renderPose(driver.alpha, render.quats, render.trans, render.root);
+          writeInstance(state, page, j, render.quats, render.trans, render.root);
         }
       }
-      flush();
+      flush(state);
       return steps;
     },
     /** The fixed-step driver (hz, alpha, accumulator) update() uses. */
     driver,
     /** Upload whatever spawn/despawn left dirty (called by the owner before rendering). */
-    flush,
+    flush: () => flush(state),
     instance(id) {
-      const { page, j } = locate(id);
+      const { page, j } = locate(state, id);
       const m = page.motions[j];
       return { index: j, alive: page.alive[j] === 1, seed: page.seed[j], spawnTick: page.spawnTick[j],
         tick: m ? m.tick : null, root: m ? Array.from(m.root) : null, bounds: Array.from(page.bounds.subarray(6 * j, 6 * j + 6)),
@@ -371,21 +239,21 @@ export async function createCreaturePopulation(renderer, options = {}) {
     },
     /** The locomotion core of a live instance (createMotion: state, gates, renderPose), or null. */
     motion(id) {
-      const { page, j } = locate(id);
+      const { page, j } = locate(state, id);
       return page.motions[j];
     },
     stateHash() {
-      return hashBytes(pages.map((p) => new Uint8Array(p.staging.buffer, p.staging.byteOffset, p.staging.byteLength)), tick);
+      return hashBytes(pages.map((p) => new Uint8Array(p.staging.buffer, p.staging.byteOffset, p.staging.byteLength)), state.tick);
     },
     /** Switch every page to debug mode `m` (a variant built on first use; 'off' is the shipped one). */
     setDebugMode(m) {
       checkDebugMode(m);
-      const rerun = kernelKind(m) !== kernelKind(mode);
+      const rerun = kernelKind(m) !== kernelKind(state.mode);
       for (const page of pages) {
-        showMode(page, m);
-        if (rerun) deformRange(page, 0, page.size - 1);
+        showMode(state, page, m);
+        if (rerun) deformRange(state, page, 0, page.size - 1);
       }
-      mode = m;
+      state.mode = m;
     },
     setTier(t) {
       if (t !== data.tier) throw new Error(`tier: this package was built for tier ${data.tier} (got ${t}); rebuild with --tier ${t}`);
@@ -399,12 +267,12 @@ export async function createCreaturePopulation(renderer, options = {}) {
       for (const page of pages) page.mesh.count = Math.max(1, page.mesh.count);
       for (const m of SHIPPED_VARIANTS) {
         for (const page of pages) {
-          showMode(page, m);
+          showMode(state, page, m);
           dispatchDeform(renderer, page.kernel, 0, 0);
         }
         await renderer.compileAsync(scene, camera);
       }
-      pages.forEach((p, i) => { p.mesh.count = saved[i]; showMode(p, mode); });
+      pages.forEach((p, i) => { p.mesh.count = saved[i]; showMode(state, p, state.mode); });
     },
     dispose() {
       geometry.dispose();
@@ -419,12 +287,12 @@ export async function createCreaturePopulation(renderer, options = {}) {
     records,
     /** The page holding instance `id` and its index there. */
     locate(id) {
-      const { page, j } = locate(id);
+      const { page, j } = locate(state, id);
       return { page, index: j };
     },
     /** Pose rows of one instance from the CPU staging copy (what the next upload sends). */
     stagedPose(id) {
-      const { page, j } = locate(id);
+      const { page, j } = locate(state, id);
       return page.staging.slice(j * floatsPerInstance, (j + 1) * floatsPerInstance);
     },
     /** The debug-mode variants built so far ('off' is the shipped one). */

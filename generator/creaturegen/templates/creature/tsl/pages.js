@@ -1,0 +1,78 @@
+// The pose pages of a population: fixed-capacity slices of bodies, each with its vec4 pose storage (and the
+// CPU staging copy it uploads from), its deform storage, one mesh drawn once per pass, and the material
+// and pre-pass kernel of the debug mode shown. Everything here is created before the first visible frame
+// (createCreaturePopulation and warm()); a spawn only writes rows into a page that already exists.
+import * as THREE from 'three/webgpu';
+import { instancedArray } from 'three/tsl';
+import { GENOME_LENGTH } from '../core/genome.js';
+import { bodyFunctions } from './body.js';
+import { createDeformKernel, deformStorage, deformView } from './deform.js';
+import { createBodyMaterial } from './material.js';
+import { createShellMesh } from './shell.js';
+
+/** Allocate every page of `state` (capacity bodies in pages of state.pageSize) and add their meshes. */
+export function createPages(state) {
+  const { data, capacity, pageSize, floatsPerInstance, geometry, group, vertices } = state;
+  const pages = [];
+  for (let first = 0; first < capacity; first += pageSize) {
+    const size = Math.min(pageSize, capacity - first);
+    const pose = instancedArray(new Float32Array(size * floatsPerInstance), 'vec4');
+    const mesh = new THREE.Mesh(geometry, null);
+    mesh.count = 0;
+    mesh.castShadow = true;
+    mesh.receiveShadow = true;
+    mesh.boundingSphere = new THREE.Sphere(new THREE.Vector3(), 0);
+    mesh.name = `${data.slug}.page${pages.length}`;
+    group.add(mesh);
+    const deform = deformStorage(size, vertices);
+    pages.push({
+      first, size, pose, mesh, staging: pose.value.array, deform, deformView: deformView(deform), kernels: new Map(), shell: null,
+      alive: new Uint8Array(size), seed: new Uint32Array(size), spawnTick: new Float64Array(size),
+      motions: new Array(size).fill(null), bounds: new Float64Array(6 * size),
+      genomes: new Float64Array(GENOME_LENGTH * size), colours: new Float64Array(3 * data.slotCount * size),
+      dirtyLo: Infinity, dirtyHi: -1,
+    });
+  }
+  return pages;
+}
+
+/** The pre-pass variant of a debug mode: 'skin-only' stores uncorrected positions, every other mode the body. */
+export const kernelKind = (m) => (m === 'skin-only' ? 'skin-only' : 'body');
+
+// One material per (signatures, tier, mode, registers) and page: built on first use, kept for reuse.
+function materialFor(state, page, m) {
+  const { data, layout, pages, variants } = state;
+  const shown = m === 'shell' ? 'off' : m;
+  const key = `${[data.signatures.compilerSignature, data.signatures.topologySignature, data.tier, shown, data.registers].join('|')}`
+    + `|page${pages.indexOf(page)}`;
+  if (!variants.has(key)) variants.set(key, createBodyMaterial(layout, page.pose, page.deformView, shown));
+  return variants.get(key);
+}
+
+function kernelFor(state, page, kind) {
+  if (!page.kernels.has(kind)) {
+    const { layout, programs, records, vertices } = state;
+    const fns = bodyFunctions(layout, page.pose, programs);
+    page.kernels.set(kind, createDeformKernel(layout, fns, {
+      pose: page.pose, records, deform: page.deform, size: page.size, vertices, skinOnly: kind === 'skin-only',
+    }));
+  }
+  return page.kernels.get(kind);
+}
+
+/** Show debug mode `m` on `page`: its material, its pre-pass kernel, and the capsule shell for 'shell'. */
+export function showMode(state, page, m) {
+  const { data, layout, group } = state;
+  page.mesh.material = materialFor(state, page, m);
+  page.kernel = kernelFor(state, page, kernelKind(m));
+  if (m === 'shell' && !page.shell) {
+    page.shell = createShellMesh(layout, page.pose, page.mesh.name);
+    page.shell.boundingSphere = page.mesh.boundingSphere;
+    group.add(page.shell);
+  }
+  page.mesh.visible = m !== 'shell';
+  if (page.shell) {
+    page.shell.visible = m === 'shell';
+    page.shell.count = page.mesh.count * data.slotCount;
+  }
+}
