@@ -5,6 +5,10 @@ import type { CreatureData } from '../core/index.js';
 import type { CreaturePopulation } from '../index.js';
 import type { Layout, PoseStorage } from './index.js';
 
+// Only what is declared `export` below is public: without this, TypeScript exports every top-level
+// declaration of a declaration file.
+export {};
+
 export interface CreatureDiagnostics {
   readSkinned(id: number): Promise<{ skinned: Float32Array; corrected: Float32Array; accepted: Float32Array; gradient: Float32Array; distance: Float32Array }>;
   probeField(id: number, xyz: Float32Array, program?: number): Promise<Float32Array>;
