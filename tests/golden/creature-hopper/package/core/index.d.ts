@@ -9,9 +9,6 @@ export type TierName = "hero" | "repeated" | "distant";
 export type LocomotionType = "none" | "biped" | "quadruped" | "hexapod" | "octopod" | "walker" | "hopper" | "flyer" | "swimmer";
 export type Vec3 = [number, number, number];
 
-/** The LCG every instance stream uses: state' = (a·state + c) mod 2^32. */
-export interface Lcg { readonly a: number; readonly c: number }
-
 /** Cache identities of the build: the .glb carries the same three (checked when it loads). */
 export interface CreatureSignatures {
   readonly compilerSignature: string;
@@ -19,23 +16,136 @@ export interface CreatureSignatures {
   readonly geometryDigest: string;
 }
 
+// The interfaces of CREATURE (core/data.js), rendered from the records creaturegen builds it as.
+/** The LCG every instance stream uses: state' = (a·state + c) mod 2^32. */
+export interface Lcg {
+  readonly a: number;
+  readonly c: number;
+}
+
+/**
+ * The bounds of the colour genes, as the runtime reads them (CREATURE.genetics): each gene in [-1, 1) times
+ * its bound.
+ */
+export interface ColourGenetics {
+  /** Largest hue rotation, radians (the spec states degrees). */
+  readonly hueRad: number;
+  /** Largest relative change of chroma. */
+  readonly chroma: number;
+  /** Largest shift of OKLab lightness. */
+  readonly lightness: number;
+}
+
 /** One leg of a walker or hopper (two slots: upper and lower), rest geometry in creature-local metres. */
 export interface LegData {
-  readonly part: string; readonly upper: number; readonly lower: number;
-  readonly hip: Vec3; readonly knee: Vec3; readonly foot: Vec3; readonly hint: Vec3; readonly hinge: Vec3;
-  readonly a: number; readonly b: number; readonly group: number; readonly reachMin: number; readonly reachMax: number;
-  readonly tuck: number; readonly crouch: number;
+  readonly part: string;
+  /** Slot of the thigh (hip to knee). */
+  readonly upper: number;
+  /** Slot of the shin (knee to foot). */
+  readonly lower: number;
+  readonly hip: Vec3;
+  readonly knee: Vec3;
+  readonly foot: Vec3;
+  /** Thigh length. */
+  readonly a: number;
+  /** Shin length. */
+  readonly b: number;
+  /** Unit direction from the hip-foot midpoint to the rest knee: the side the knee bends to. */
+  readonly hint: Vec3;
+  /**
+   * The knee's rest hinge axis (normal of the hip-knee-foot plane): the slot frames' second axis, so the
+   * bones never twist as the leg swings (motion/ik.py).
+   */
+  readonly hinge: Vec3;
+  /** Phase group: one group swings at a time. */
+  readonly group: number;
+  /** Shortest hip-foot distance the IK allows. */
+  readonly reachMin: number;
+  /** Longest hip-foot distance the IK allows (just short of full extension). */
+  readonly reachMax: number;
+  /**
+   * A hopper's foot at the apex: hip + (foot − hip)·tuck (a ratio, so an individual's size scales it with hip
+   * and foot).
+   */
+  readonly tuck: number;
+  /** Share of the legs' rest hip height a hopper on legs sinks by in its crouch and landing. */
+  readonly crouch: number;
 }
 
-/** A rope part: a chain of slots simulated follow-the-leader. */
+/** A rope part (tail, tentacle): a chain of slots simulated follow-the-leader. */
 export interface RopeData {
-  readonly part: string; readonly slots: readonly number[]; readonly parent: number;
-  readonly rest: readonly Vec3[]; readonly before: Vec3; readonly radius: readonly number[];
-  readonly segment: number; readonly bendMin: number; readonly bendCos: number; readonly bendSin: number;
+  readonly part: string;
+  /** The chain's slots, anchor first. */
+  readonly slots: readonly number[];
+  /** The slot the anchor rides on. */
+  readonly parent: number;
+  /** Rest nodes: every slot's start, then the last slot's end. */
+  readonly rest: readonly Vec3[];
+  /** The rest point one segment before the anchor, on the body: the bend limit's first reference. */
+  readonly before: Vec3;
+  /** Radius at every node (creatures on a support keep their nodes this far above it). */
+  readonly radius: readonly number[];
+  /** Rest length of every segment. */
+  readonly segment: number;
+  /** Least distance between a node's neighbours: the bend limit as a relaxation constraint. */
+  readonly bendMin: number;
+  /** Cosine of the bend limit: the follow-the-leader pass's cone (motion/ropes.py follow). */
+  readonly bendCos: number;
+  /** Sine of the bend limit. */
+  readonly bendSin: number;
 }
 
+/** A flapping part: one slot turned about Z at the flap frequency. */
 export interface WingData {
-  readonly part: string; readonly slot: number; readonly sign: number; readonly amplitude: number; readonly length: number;
+  readonly part: string;
+  readonly slot: number;
+  /** +1 for a wing reaching toward +x, −1 toward −x, so the wings of both sides flap as mirror images. */
+  readonly sign: number;
+  /** Flap amplitude, radians. */
+  readonly amplitude: number;
+  readonly length: number;
+}
+
+/**
+ * The stated constants the motion reads (motion/rig.py, where each is explained), shipped with the data so
+ * the JS core never restates them.
+ */
+export interface MotionConstants {
+  readonly swingFroude: number;
+  readonly stepLead: number;
+  readonly settleSlack: number;
+  readonly hopCrouchS: number;
+  readonly hopLandS: number;
+  readonly hopSquash: number;
+  readonly hopStretch: number;
+  readonly strouhal: number;
+  readonly swimResponse: number;
+  readonly ropeSubsteps: number;
+  readonly ropePasses: number;
+  readonly ropeDamping: number;
+  readonly ropeBendLimitDeg: number;
+}
+
+/**
+ * Gait genes: `fields[i]` lists the motion fields gene i scales by 1 + jitter·gene; `size` bounds the size
+ * gene.
+ */
+export interface MotionGenes {
+  readonly jitter: number;
+  readonly fields: readonly (readonly string[])[];
+  readonly size: number;
+}
+
+/**
+ * Motion fields scaled with an individual's size, by group: lengths by the size, speeds by its square root
+ * (motion/rig.py SIZED_FIELDS), so the JS core scales the very same fields.
+ */
+export interface SizedFields {
+  readonly speeds: readonly string[];
+  readonly top: readonly string[];
+  readonly legs: readonly string[];
+  readonly ropes: readonly string[];
+  readonly wings: readonly string[];
 }
 
 /** CREATURE.motion: what createMotion runs (creaturegen's motion/rig.py build_motion, as JSON). */
@@ -43,23 +153,58 @@ export interface MotionData {
   readonly type: LocomotionType;
   /** Fixed steps per second. */
   readonly hz: number;
-  readonly speed: number; readonly bodyScale: number; readonly groundY: number; readonly centreY: number;
-  readonly pathRadius: number; readonly stepLength: number; readonly stepLengthSpec: number; readonly stepLimit: number;
-  readonly stepHeight: number; readonly hopLength: number; readonly hopHeight: number; readonly altitude: number;
-  readonly undulation: number; readonly buoyancy: number; readonly groups: number;
+  /** Along the path, m/s. */
+  readonly speed: number;
+  readonly bodyScale: number;
+  /** Rest height of the ground: the legs' mean rest foot height, else the body's lowest point. */
+  readonly groundY: number;
+  readonly centreY: number;
+  /** Radius of the circle the creature travels. */
+  readonly pathRadius: number;
+  /** The lag that lifts a foot: the spec's step length, capped by the legs' reach (stepLimit). */
+  readonly stepLength: number;
+  readonly stepLengthSpec: number;
+  readonly stepLimit: number;
+  readonly stepHeight: number;
+  readonly hopLength: number;
+  readonly hopHeight: number;
+  readonly altitude: number;
+  readonly undulation: number;
+  readonly buoyancy: number;
+  /** Phase groups of the legs. */
+  readonly groups: number;
   readonly legs: readonly LegData[];
   readonly ropes: readonly RopeData[];
   readonly wings: readonly WingData[];
+  /** Slots without a parent. */
   readonly roots: readonly number[];
+  /** Every slot's parent slot (−1 at a root). */
   readonly parent: readonly number[];
+  /** Slots, parents before children. */
   readonly order: readonly number[];
+  /** Every slot's pivot: where it turns about its parent. */
   readonly pivot: readonly Vec3[];
-  readonly constants: Readonly<Record<string, number>>;
+  readonly constants: MotionConstants;
+  /** Rope nodes stay above the support by their radius (creatures that stand on one). */
   readonly ropeGround: boolean;
-  /** Gait genes: `fields[i]` lists the motion fields gene i scales by 1 + jitter·gene; `size` bounds the size gene. */
-  readonly genes: { readonly jitter: number; readonly fields: readonly (readonly string[])[]; readonly size: number };
-  /** Motion fields scaled with an individual's size, by group. */
-  readonly lengths: Readonly<Record<string, readonly string[]>>;
+  readonly genes: MotionGenes;
+  readonly lengths: SizedFields;
+}
+
+/** The local correction of the skinned surface toward the field's iso level (surface/correct.py). */
+export interface CorrectionData {
+  /** Shared trial budget per vertex. */
+  readonly budget: number;
+  /** A vertex within this fraction of its trust radius of the iso level stops spending trials. */
+  readonly earlyOut: number;
+  /** Squared-gradient floor below which a vertex has no usable Newton direction. */
+  readonly gradientFloor: number;
+}
+
+/** The reference surface's size. */
+export interface MeshCounts {
+  readonly vertices: number;
+  readonly triangles: number;
 }
 
 /** CREATURE: the build plan of this creature, as data (core/data.js). */
@@ -72,12 +217,15 @@ export interface CreatureData {
   readonly specSha256: string;
   readonly signatures: CreatureSignatures;
   readonly tier: TierName;
-  /** The reference surface's file name in assets/ (`new URL(surfaceFile, assetBase)` when assetBase is given). */
+  /**
+   * The reference surface's file name in assets/ (`new URL(surfaceFile, assetBase)` when assetBase is given).
+   */
   readonly surfaceFile: string;
   /** three.js REVISION the package was built for ('185'). */
   readonly threeRevision: string;
   readonly bodyScale: number;
   readonly slotCount: number;
+  /** Pose-texture parts per instance: every slot, and one for the root rows. */
   readonly maxParts: number;
   readonly poseRows: number;
   /** Rest slot table, one row of 12 numbers per slot. */
@@ -85,7 +233,8 @@ export interface CreatureData {
   readonly slotNames: readonly string[];
   readonly roundCone: readonly number[];
   readonly lcg: Lcg;
-  readonly genetics: { readonly hueRad: number; readonly chroma: number; readonly lightness: number };
+  readonly genetics: ColourGenetics;
+  /** OKLab coordinates of every slot's authored colour, which the colour genes mutate. */
   readonly slotLab: readonly Vec3[];
   readonly motion: MotionData;
   readonly tickRate: number;
@@ -93,16 +242,18 @@ export interface CreatureData {
   readonly programCount: number;
   readonly fullProgram: number;
   readonly noProgram: number;
-  /** The candidate code of a vertex that evaluates no field (a skin-represented tier): skinned position
-   * and normal, baked colour. */
+  /**
+   * The candidate code of a vertex that evaluates no field (a skin-represented tier): skinned position and
+   * normal, baked colour.
+   */
   readonly skinProgram: number;
   readonly registers: number;
   readonly candidateNote: string;
   readonly gradientFloor: number;
   readonly tiny: number;
   readonly kFloor: number;
-  readonly correction: { readonly budget: number; readonly earlyOut: number; readonly gradientFloor: number };
-  readonly mesh: { readonly vertices: number; readonly triangles: number };
+  readonly correction: CorrectionData;
+  readonly mesh: MeshCounts;
   readonly debugModes: readonly DebugMode[];
   readonly deformStride: number;
 }
