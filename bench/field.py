@@ -43,7 +43,8 @@ from creaturegen.field.primitives import primitive_distance
 from creaturegen.field.sampler import evaluate_distance, sample_distance, sample_graph
 from creaturegen.model import layout as col
 from creaturegen.model.graph import BlendGraph
-from creaturegen.rig import CompiledRig, compile_rig
+from creaturegen.motion.compiled import compile_creature
+from creaturegen.rig import CompiledRig
 from creaturegen.spec import CharacterSpec, load_spec
 
 REPO = Path(__file__).resolve().parents[1]
@@ -179,9 +180,10 @@ def measure_example(
 ) -> dict[str, Any]:
     spec = load_spec(path)
     assert isinstance(spec, CharacterSpec)
-    rig = compile_rig(spec)
+    creature = compile_creature(spec)
+    rig = creature.rig
     started = time.perf_counter()
-    found = build_candidates(spec, rig, "hero")
+    found = build_candidates(creature, "hero")
     elapsed = time.perf_counter() - started
     log(f"  {len(found.programs)} regions, K_used {found.k_used} (build_candidates {elapsed:.1f} s, untimed)")
     programs = found.programs

@@ -16,6 +16,7 @@ from creaturegen.candidates.regions import RegionSearch, Tier, search
 from creaturegen.field.floors import floors_for
 from creaturegen.field.sampler import sample_graph
 from creaturegen.model.rotations import posed_slots
+from creaturegen.motion.compiled import compile_creature
 from creaturegen.motion.envelope import pose_envelope
 from creaturegen.rig import CompiledRig, compile_rig
 from creaturegen.spec import CharacterSpec, load_spec
@@ -32,8 +33,8 @@ def _compiled(path: Path) -> tuple[CharacterSpec, CompiledRig]:
 
 @cache
 def _hero(path: Path) -> CandidateSet:
-    spec, rig = _compiled(path)
-    return build_candidates(spec, rig, "hero")
+    spec, _rig = _compiled(path)
+    return build_candidates(compile_creature(spec), "hero")
 
 
 @pytest.mark.parametrize("path", CREATURES, ids=lambda p: p.name)
@@ -55,7 +56,7 @@ def test_an_uncertified_omission_is_flagged_and_really_changes_the_field() -> No
     head = rig.slot_parts.index("head")
     centre = rig.slots[head, 0:3]
     lo, hi = centre - 0.1, centre + 0.1
-    excursion = pose_envelope(spec, rig).slot_excursion
+    excursion = pose_envelope(compile_creature(spec)).slot_excursion
     bounds = leaf_bounds(rig.slots, excursion, lo, hi)
     tol = tolerances(rig)
     kept = set(range(rig.slot_count)) - {head}
@@ -111,14 +112,14 @@ CAPPED = Tier("capped", 4, 4)
 
 def _capped(path: Path) -> RegionSearch:
     spec, rig = _compiled(path)
-    return search(rig, pose_envelope(spec, rig).slot_excursion, CAPPED, tolerances(rig))
+    return search(rig, pose_envelope(compile_creature(spec)).slot_excursion, CAPPED, tolerances(rig))
 
 
 def test_the_lower_tiers_have_no_candidate_programs() -> None:
-    spec, rig = _compiled(EXAMPLES / "reference" / "flyer.json")
+    spec, _rig = _compiled(EXAMPLES / "reference" / "flyer.json")
     for tier in ("repeated", "distant"):
         with pytest.raises(TierRejectedError, match=rf"^tier {tier}: skin representation"):
-            build_candidates(spec, rig, tier)
+            build_candidates(compile_creature(spec), tier)
 
 
 def test_small_tiers_are_rejected_with_the_region_and_omission_named() -> None:
@@ -139,7 +140,7 @@ def test_the_sweep_reads_the_motion_and_the_certificates_contain_it() -> None:
     individuals the envelope never stepped)."""
     spec, rig = _compiled(EXAMPLES / "reference" / "quadruped.json")
     found = _hero(EXAMPLES / "reference" / "quadruped.json")
-    env = pose_envelope(spec, rig)
+    env = pose_envelope(compile_creature(spec))
     assert found.sweep.motion_poses == len(env.poses) > 0
     excursion = env.slot_excursion
     for pose in env.poses:

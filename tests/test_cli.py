@@ -13,6 +13,7 @@ from conftest import EXAMPLES, REPO, run_cli
 from creaturegen import __version__, cli, cli_build
 from creaturegen.cli_errors import EXIT_GATE_FAILED, EXIT_INVALID, EXIT_OK, EXIT_REFUSED
 from creaturegen.field.sampler import sample
+from creaturegen.motion.compiled import compile_creature
 from creaturegen.rig import compile_rig
 from creaturegen.spec import CharacterSpec, load_spec
 from creaturegen.surface.build import SurfaceBuild
@@ -192,7 +193,7 @@ def test_population_short_of_n_identities_exits_3(
     ) -> cli_build._Identity | int:  # the authored identity passes, every variant is refused
         if name != str(source):
             return EXIT_REFUSED
-        return cli_build._Identity(name, one, data, compile_rig(one), cast(SurfaceBuild, None))
+        return cli_build._Identity(name, compile_creature(one), data, cast(SurfaceBuild, None))
 
     monkeypatch.setattr(cli_build, "_identity", identity)
     out = tmp_path / "out"

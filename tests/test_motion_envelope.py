@@ -14,6 +14,7 @@ from conftest import CREATURE_EXAMPLES, MOTION_FIXTURES, spec_file
 from creaturegen.model import layout as col
 from creaturegen.model.skeleton import Skeleton, build_skeleton
 from creaturegen.motion import envelope
+from creaturegen.motion.compiled import compile_creature
 from creaturegen.motion.data import MotionData
 from creaturegen.motion.providers import AnalyticWater
 from creaturegen.motion.rig import ROPE_BEND_LIMIT_DEG, build_motion
@@ -41,7 +42,7 @@ def test_random_individuals_stay_inside_the_widened_envelope(name: str) -> None:
     bend and twist. The corners alone are not enough (a random individual goes past them); the margins
     are what this checks."""
     spec, rig, data, skeleton = _load(name)
-    env = envelope.pose_envelope(spec, rig)
+    env = envelope.pose_envelope(compile_creature(spec))
     assert env.samples > 0
     assert env.ticks >= 240
     runs = [
@@ -71,8 +72,8 @@ def test_rigid_body_motion_is_taken_out_and_a_flap_moves_its_wing_by_its_chord()
     """The flyer banks its whole body, which moves no slot relative to another: the body's displacement is
     zero. A wing flapping by ±A about its root moves its tip by at most 2·|b − a|·sin(A/2), and a whole
     flap cycle reaches it."""
-    spec, rig, data, _ = _load("reference/flyer.json")
-    env = envelope.pose_envelope(spec, rig)
+    spec, _rig, data, _ = _load("reference/flyer.json")
+    env = envelope.pose_envelope(compile_creature(spec))
     root = data.roots[0]
     assert env.slot_displacement[root] <= 1e-12
     for wing in data.wings:
@@ -106,7 +107,7 @@ def test_ropes_keep_their_length_and_bend_limit() -> None:
 
 def test_the_disk_copy_is_the_measured_envelope_bit_for_bit() -> None:
     spec, rig, data, _skeleton = _load("reference/hopper.json")
-    env = envelope.pose_envelope(spec, rig)
+    env = envelope.pose_envelope(compile_creature(spec))
     copy = envelope._from_json(envelope._to_json(env))
     assert copy.joints == env.joints
     # Each turning joint names the run where it turns most (a refusal's message repeats it).
@@ -147,7 +148,7 @@ def test_a_started_envelope_is_the_measured_one_and_stops_when_left(
     monkeypatch.setenv("CREATUREGEN_CACHE", str(tmp_path))
     monkeypatch.setenv(envelope.WORKERS_ENV, "2")
     spec, rig, data, skeleton = _load("reference/flyer.json")
-    with envelope.start_pose_envelope(spec, rig) as pending:
+    with envelope.start_pose_envelope(compile_creature(spec)) as pending:
         pool = pending._pool
         assert pool is not None, "two workers were asked for: the runs step in forked processes"
         workers = list(pool._pool)
@@ -156,7 +157,7 @@ def test_a_started_envelope_is_the_measured_one_and_stops_when_left(
     assert not any(w.is_alive() for w in workers)
 
     monkeypatch.setenv("CREATUREGEN_CACHE", str(tmp_path / "other"))
-    with envelope.start_pose_envelope(spec, rig) as pending:
+    with envelope.start_pose_envelope(compile_creature(spec)) as pending:
         workers = list(pending._pool._pool)
     assert not any(w.is_alive() for w in workers), (
         "workers outlived a build that never asked for the envelope"

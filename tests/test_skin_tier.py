@@ -16,6 +16,7 @@ from creaturegen.field.floors import floors_for
 from creaturegen.field.sampler import sample_graph
 from creaturegen.model import layout as col
 from creaturegen.model.graph import BlendGraph, Ref
+from creaturegen.motion.compiled import compile_creature
 from creaturegen.rig import CompiledRig, compile_rig
 from creaturegen.spec import CharacterSpec, load_spec
 from creaturegen.surface.asset import SurfaceAsset
@@ -45,8 +46,8 @@ def _compiled(name: str) -> tuple[CharacterSpec, CompiledRig]:
 
 @cache
 def _built(name: str, tier: str) -> SurfaceBuild:
-    spec, rig = _compiled(name)
-    return build_surface(spec, rig, tier=tier, backend="numpy", progress=lambda _: None)
+    spec, _rig = _compiled(name)
+    return build_surface(compile_creature(spec), tier=tier, backend="numpy", progress=lambda _: None)
 
 
 def test_baked_colour_is_the_kernel_truncated_to_four_leaves() -> None:

@@ -18,7 +18,7 @@ import pytest
 from conftest import CREATURE_EXAMPLES, EXAMPLES, REPO, rest_surface, run_cli
 from creaturegen.creature.assets import surface_path
 from creaturegen.model.skeleton import build_skeleton
-from creaturegen.rig import compile_rig
+from creaturegen.motion.compiled import compile_creature
 from creaturegen.spec import CharacterSpec, load_spec
 from creaturegen.surface import lattice, mesh_gates
 from creaturegen.surface.build import SurfaceBuild, build_surface
@@ -44,7 +44,7 @@ def _spec(name: str) -> CharacterSpec:
 def _built(name: str, cache_root: str) -> SurfaceBuild:
     spec = _spec(name)
     return build_surface(
-        spec, compile_rig(spec), backend="wgpu", cache=SurfaceCache(Path(cache_root)), progress=lambda _: None
+        compile_creature(spec), backend="wgpu", cache=SurfaceCache(Path(cache_root)), progress=lambda _: None
     )
 
 
@@ -92,7 +92,7 @@ def test_a_cache_hit_skips_extraction(cache_root: str) -> None:
     messages: list[str] = []
     spec = _spec(name)
     again = build_surface(
-        spec, compile_rig(spec), cache=SurfaceCache(Path(cache_root)), progress=messages.append
+        compile_creature(spec), cache=SurfaceCache(Path(cache_root)), progress=messages.append
     )
     assert again.cached
     assert not any("extracted" in m for m in messages)
@@ -105,7 +105,7 @@ def test_a_failed_gate_stops_the_build_and_names_it(monkeypatch: pytest.MonkeyPa
     monkeypatch.setattr(lattice, "MAX_REFINEMENTS", 0)
     spec = _spec("reference/hopper.json")
     with pytest.raises(SurfaceRejectedError, match=r"gate minAngleP1 = .* threshold 89"):
-        build_surface(spec, compile_rig(spec), backend="numpy", cache=None, progress=lambda _: None)
+        build_surface(compile_creature(spec), backend="numpy", cache=None, progress=lambda _: None)
 
 
 def test_every_failed_mesh_gate_names_the_part_nearby() -> None:

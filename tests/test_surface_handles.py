@@ -18,7 +18,7 @@ import pytest
 from conftest import REPO, rest_surface, run_cli
 from creaturegen.model import layout as col
 from creaturegen.model.skeleton import build_skeleton
-from creaturegen.rig import compile_rig
+from creaturegen.motion.compiled import compile_creature
 from creaturegen.spec import CharacterSpec, load_spec
 from creaturegen.surface.build import build_surface
 from creaturegen.surface.handles import (
@@ -125,7 +125,7 @@ def test_the_build_names_the_contacts_and_stops_refining() -> None:
     assert isinstance(spec, CharacterSpec)
     said: list[str] = []
     with pytest.raises(SurfaceRejectedError) as caught:
-        build_surface(spec, compile_rig(spec), tier="hero", backend="numpy", progress=said.append)
+        build_surface(compile_creature(spec), tier="hero", backend="numpy", progress=said.append)
     message = str(caught.value)
     assert "gate euler" in message, message
     assert "genus 4, expected 0" in message, message

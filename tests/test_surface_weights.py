@@ -17,6 +17,7 @@ import pytest
 
 from conftest import EXAMPLES, rest_surface
 from creaturegen.model.skeleton import Skeleton, build_skeleton
+from creaturegen.motion.compiled import compile_creature
 from creaturegen.spec import CharacterSpec, load_spec
 from creaturegen.surface.field64 import BodyField
 from creaturegen.surface.mesh import Mesh
@@ -231,7 +232,7 @@ def test_the_build_reads_still_joints_from_the_motion() -> None:
     spec = load_spec(EXAMPLES / "lizard.json")
     rig = compile_rig(spec)
     skeleton = build_skeleton(spec, rig)
-    still = {skeleton.names[c] for c in pose_envelope(spec, rig).still_joints(rig.body_scale)}
+    still = {skeleton.names[c] for c in pose_envelope(compile_creature(spec)).still_joints(rig.body_scale)}
     assert {"part.head", "part.snout"} <= still
     assert not any(name.startswith(("part.leg", "part.tail")) for name in still)
 
@@ -245,7 +246,6 @@ def test_a_steep_weight_rim_is_split_before_the_build_refuses(monkeypatch: pytes
     the harmonic weight falls from 1 to 0.6 across one edge at its rim (0.4006 against the gate's 0.4).
     The build splits the triangles along the steepest edges and keeps the split mesh, every gate passing;
     without that remedy the same build is refused, naming the gate and the two tail segments."""
-    from creaturegen.rig import compile_rig
     from creaturegen.surface import build as surface_build
     from creaturegen.surface import remedies
     from creaturegen.surface.refusal import SurfaceRejectedError
@@ -253,11 +253,11 @@ def test_a_steep_weight_rim_is_split_before_the_build_refuses(monkeypatch: pytes
     spec = load_spec(STEEP_ROPE)
     assert isinstance(spec, CharacterSpec)
     said: list[str] = []
-    built = surface_build.build_surface(spec, compile_rig(spec), backend="numpy", progress=said.append)
+    built = surface_build.build_surface(compile_creature(spec), backend="numpy", progress=said.append)
     assert [g.name for g in built.gates if not g.passed] == []
     continuity = next(g for g in built.gates if g.name == "weights.continuity")
     assert continuity.value < 0.4
     assert any("split where a weight drops" in line for line in said), said
     monkeypatch.setattr(remedies, "WEIGHT_SPLIT_ROUNDS", 0)
     with pytest.raises(SurfaceRejectedError, match=r"weights\.continuity = 0\.40.*part\.tail"):
-        surface_build.build_surface(spec, compile_rig(spec), backend="numpy", progress=lambda _: None)
+        surface_build.build_surface(compile_creature(spec), backend="numpy", progress=lambda _: None)

@@ -20,7 +20,8 @@ from .emit import PackageWriteError
 from .frost.build import build_frost
 from .frost.formats import FormatRefusedError
 from .lab.picture import picture_unavailable, render_picture
-from .rig import CompiledRig, RigCompileError, compile_rig
+from .motion.compiled import CompiledCreature, compile_creature
+from .rig import RigCompileError
 from .spec import CharacterSpec, SpecError, SpecValidationError, slugify, validate_bytes
 from .spec.summary import summarize
 from .surface.backends import BackendChoiceError
@@ -65,13 +66,11 @@ def build_command(args: argparse.Namespace) -> int:
     return EXIT_OK
 
 
-def surface_or_exit(
-    name: str, spec: CharacterSpec, rig: CompiledRig, tier: str, backend: str
-) -> SurfaceBuild | int:
+def surface_or_exit(name: str, creature: CompiledCreature, tier: str, backend: str) -> SurfaceBuild | int:
     """The surface at ``tier``, or the exit code of its failure, printed naming the gate, part or option:
     EXIT_REFUSED when a gate refuses the geometry, EXIT_INVALID when ``--backend`` cannot be used."""
     try:
-        return build_surface(spec, rig, tier=tier, backend=backend, cache=SurfaceCache())
+        return build_surface(creature, tier=tier, backend=backend, cache=SurfaceCache())
     except (SurfaceRejectedError, GridTooFineError, DeformationError) as exc:
         print_errors(name, [SpecError(f"surface.{tier}", str(exc))])
         return EXIT_REFUSED
@@ -82,12 +81,12 @@ def surface_or_exit(
 
 @dataclass(frozen=True)
 class _Identity:
-    """One geometry identity ready to write: its spec (and the JSON bytes it ships), rig and surface."""
+    """One geometry identity ready to write: the compiled creature (and the spec's JSON bytes it ships) and
+    its surface."""
 
     name: str
-    spec: CharacterSpec
+    creature: CompiledCreature
     data: bytes
-    rig: CompiledRig
     build: SurfaceBuild
 
 
@@ -95,13 +94,13 @@ def _identity(args: argparse.Namespace, name: str, spec: CharacterSpec, data: by
     """Compile, extract and gate one identity; on failure the exit code (errors printed, naming the gate or
     part): EXIT_INVALID for a rig the spec cannot compile to, EXIT_REFUSED for a surface gate."""
     try:
-        rig = compile_rig(spec)
+        creature = compile_creature(spec)
     except RigCompileError as exc:
         print_errors(name, exc.errors)
         return EXIT_INVALID
     steps = "narrow-band sampling, extraction, gates, skin weights, deformation sweeps"
     print(f"==> surface {args.tier}: {steps}")
-    build = surface_or_exit(name, spec, rig, args.tier, args.backend)
+    build = surface_or_exit(name, creature, args.tier, args.backend)
     if isinstance(build, int):
         return build
     print_gates(build)
@@ -112,7 +111,7 @@ def _identity(args: argparse.Namespace, name: str, spec: CharacterSpec, data: by
             print_errors(name, [SpecError(f"surface.{args.tier}", str(exc))])
             return EXIT_REFUSED
     print_surface_summary(build)
-    return _Identity(name, spec, data, rig, build)
+    return _Identity(name, creature, data, build)
 
 
 #: Morphology variants drawn per identity asked for before --population gives up.
@@ -146,7 +145,7 @@ def _identities(args: argparse.Namespace, spec: CharacterSpec, data: bytes) -> l
             print_errors(name, exc.errors)
             variant = None
         if isinstance(variant, CharacterSpec) and slugify(variant.name) in {
-            slugify(o.spec.name) for o in out
+            slugify(o.creature.spec.name) for o in out
         }:
             print_errors(
                 name,
@@ -184,7 +183,7 @@ def _build_creature(args: argparse.Namespace, spec: CharacterSpec, data: bytes) 
     for one in identities:
         try:
             render = render_picture if picture else None
-            folder = build_creature(one.spec, one.rig, one.data, one.build, Path(args.out), render)
+            folder = build_creature(one.creature, one.data, one.build, Path(args.out), render)
         except PackageWriteError as exc:
             print(f"{one.name}: cannot write the package: {exc}", file=sys.stderr)
             return EXIT_INVALID

@@ -16,6 +16,7 @@ from .cli_build import surface_or_exit
 from .cli_errors import EXIT_GATE_FAILED, EXIT_INVALID, EXIT_OK, print_errors
 from .cli_report import print_gates
 from .field.sampler import sample
+from .motion.compiled import compile_creature
 from .rig import CompiledRig, RigCompileError, compile_rig
 from .rig.report import describe_rig
 from .spec import CharacterSpec, SpecError, SpecValidationError, load_spec
@@ -115,11 +116,12 @@ def inspect_command(args: argparse.Namespace) -> int:
         print(f"--tiers: unknown tier {unknown[0]!r} (known: {', '.join(TIERS)})", file=sys.stderr)
         return EXIT_INVALID
     print(f"==> candidate programs for tiers {', '.join(tiers)}", file=sys.stderr)
-    report["candidates"] = describe_candidates(spec, rig, tiers)
+    creature = compile_creature(spec)
+    report["candidates"] = describe_candidates(creature, tiers)
     surface = None
     if args.surface:
         print(f"==> surface {args.surface}", file=sys.stderr)
-        found = surface_or_exit(args.spec, spec, rig, args.surface, args.backend)
+        found = surface_or_exit(args.spec, creature, args.surface, args.backend)
         if isinstance(found, int):
             return found
         surface = found

@@ -5,9 +5,9 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 from ..field.floors import floors_for
+from ..motion.compiled import CompiledCreature
 from ..motion.envelope import PoseEnvelope, pose_envelope
 from ..rig import CompiledRig
-from ..spec import CharacterSpec
 from .program import CandidateProgram, Certificate
 from .regions import DEFAULT_TIER, TIERS, Tier, TierRejectedError, Tolerances, search
 from .sweep import SweepResult, run_sweep
@@ -78,7 +78,7 @@ def skin_note(tier: str) -> str:
 
 
 def build_candidates(
-    spec: CharacterSpec, rig: CompiledRig, tier: str, envelope: PoseEnvelope | None = None
+    creature: CompiledCreature, tier: str, envelope: PoseEnvelope | None = None
 ) -> CandidateSet:
     """Programs for every region, certified and swept; TierRejectedError names what could not be bounded.
     ``envelope`` is the motion envelope when the caller has it (the surface build does), else it is
@@ -86,9 +86,10 @@ def build_candidates(
     chosen = TIERS[tier]
     if chosen.skin is not None:
         raise TierRejectedError(skin_note(tier))
+    rig = creature.rig
     tol = tolerances(rig)
     if envelope is None:
-        envelope = pose_envelope(spec, rig)
+        envelope = pose_envelope(creature)
     found = search(rig, envelope.slot_excursion, chosen, tol)
     programs = found.programs
     result = run_sweep(rig, programs, envelope.slot_excursion, envelope.poses, tol.band, tol.k_floor)
@@ -110,7 +111,7 @@ def build_candidates(
     )
 
 
-def describe_candidates(spec: CharacterSpec, rig: CompiledRig, tiers: tuple[str, ...]) -> dict[str, object]:
+def describe_candidates(creature: CompiledCreature, tiers: tuple[str, ...]) -> dict[str, object]:
     """Per tier: accepted with its K, regions, certificates and sweep gates, or rejected with the reason."""
     out: dict[str, object] = {}
     for name in tiers:
@@ -118,7 +119,7 @@ def describe_candidates(spec: CharacterSpec, rig: CompiledRig, tiers: tuple[str,
             out[name] = {"status": "skin", "reason": skin_note(name)}
             continue
         try:
-            found = build_candidates(spec, rig, name)
+            found = build_candidates(creature, name)
         except TierRejectedError as exc:
             out[name] = {"status": "rejected", "reason": str(exc)}
             continue

@@ -9,8 +9,8 @@ from typing import Any
 
 from ..emit.render import render_folder, to_json
 from ..emit.writer import PackageFile, header_text, write_package
-from ..rig import CompiledRig
-from ..spec import CharacterSpec, slugify
+from ..motion.compiled import CompiledCreature
+from ..spec import slugify
 from ..surface.build import SurfaceBuild
 from ..surface.emit import stable_sidecar
 from ..surface.glb import glb_bytes, sidecar_bytes
@@ -46,11 +46,11 @@ def build_report(plan: dict[str, Any], surface: SurfaceBuild) -> dict[str, Any]:
 
 
 def creature_files(
-    spec: CharacterSpec, rig: CompiledRig, spec_bytes: bytes, surface: SurfaceBuild, picture: bool = False
+    creature: CompiledCreature, spec_bytes: bytes, surface: SurfaceBuild, picture: bool = False
 ) -> list[PackageFile]:
     """Every file of the package but the picture; with ``picture`` the README shows PICTURE_PATH."""
     spec_sha256 = hashlib.sha256(spec_bytes).hexdigest()
-    built = build_plan(spec, rig, surface, spec_sha256)
+    built = build_plan(creature, surface, spec_sha256)
     shown = PICTURE_PATH if picture else None
     files_list = shipped_files(built.plan["assets"]["surfacePath"], shown)
     plan = {**built.plan, "picture": shown, "files": files_list}
@@ -70,8 +70,7 @@ PictureRenderer = Callable[[Path], bytes]
 
 
 def build_creature(
-    spec: CharacterSpec,
-    rig: CompiledRig,
+    creature: CompiledCreature,
     spec_bytes: bytes,
     surface: SurfaceBuild,
     out_root: Path,
@@ -80,12 +79,13 @@ def build_creature(
     """Write the package and return its folder. With ``render`` (the lab's, lab/picture.py, handed in by
     the command line) the staged package is rendered into PICTURE_PATH before it is committed. Nothing
     is written if any step raises."""
-    files = creature_files(spec, rig, spec_bytes, surface, render is not None)
+    files = creature_files(creature, spec_bytes, surface, render is not None)
+    slug = slugify(creature.spec.name)
     if render is None:
-        return write_package(out_root, slugify(spec.name), files, None)
+        return write_package(out_root, slug, files, None)
     draw = render
 
     def add_picture(staging: Path) -> list[PackageFile]:
         return [PackageFile(PICTURE_PATH, draw(staging))]
 
-    return write_package(out_root, slugify(spec.name), files, add_picture)
+    return write_package(out_root, slug, files, add_picture)

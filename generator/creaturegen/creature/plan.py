@@ -20,9 +20,9 @@ from ..field.primitives import GRADIENT_FLOOR, slot_uses_round_cone
 from ..model import layout as col
 from ..model.genome import genetics_data, slot_lab
 from ..model.lcg import LCG
-from ..model.skeleton import Skeleton, build_skeleton
+from ..model.skeleton import Skeleton
+from ..motion.compiled import CompiledCreature
 from ..motion.data import MotionData
-from ..motion.rig import build_motion
 from ..rig import CompiledRig
 from ..spec import CharacterSpec, slugify
 from ..spec.character import LocomotionType
@@ -53,20 +53,20 @@ class CreaturePlan:
 
 
 def program_tapes(
-    spec: CharacterSpec, rig: CompiledRig, tier: str, found: CandidateSet | str | None = None
+    creature: CompiledCreature, tier: str, found: CandidateSet | str | None = None
 ) -> tuple[list[Tape], str]:
     """Tapes of the tier's candidate programs (the asset's ``_CANDIDATE`` indexes them) + the full graph.
     ``found`` is the surface build's own result when it computed one (the same call on the same rig)."""
     if found is None:
         try:
-            found = build_candidates(spec, rig, tier)
+            found = build_candidates(creature, tier)
         except TierRejectedError as exc:
             found = str(exc)
     if isinstance(found, str):
         tapes, note = [], found
     else:
         tapes, note = [compile_tape(p.graph, p.leaves) for p in found.programs], ""
-    tapes.append(compile_tape(rig.graph))
+    tapes.append(compile_tape(creature.rig.graph))
     return tapes, note
 
 
@@ -99,12 +99,11 @@ def program_data(tapes: list[Tape]) -> list[float]:
     return headers + body
 
 
-def build_plan(
-    spec: CharacterSpec, rig: CompiledRig, surface: SurfaceBuild, spec_sha256: str
-) -> CreaturePlan:
-    skeleton = build_skeleton(spec, rig)
-    motion = build_motion(spec, rig, skeleton)
-    tapes, note = program_tapes(spec, rig, surface.tier, surface.candidates)
+def build_plan(creature: CompiledCreature, surface: SurfaceBuild, spec_sha256: str) -> CreaturePlan:
+    """What the templates print for ``creature`` built with ``surface``: its skeleton and motion data as
+    the pipeline compiled them (motion/compiled.py), never rebuilt here."""
+    spec, rig, skeleton, motion = creature.spec, creature.rig, creature.skeleton, creature.motion
+    tapes, note = program_tapes(creature, surface.tier, surface.candidates)
     slug = slugify(spec.name)
     assets = asset_plan(slug, surface.signatures["geometryDigest"])
     runtime = _runtime(spec, rig, surface, spec_sha256, skeleton, motion, tapes, note, slug, assets)

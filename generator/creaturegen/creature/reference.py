@@ -19,12 +19,11 @@ from ..model import layout as col
 from ..model.genome import draw_genome, genetics_data, genome_colours, slot_lab
 from ..model.graph import Ref
 from ..model.rotations import Pose, posed_slots
-from ..model.skeleton import build_skeleton
+from ..motion.compiled import compile_creature
 from ..motion.data import MotionData
 from ..motion.providers import AnalyticWater
-from ..motion.rig import build_motion
 from ..motion.simulate import Motion
-from ..rig import CompiledRig, compile_rig
+from ..rig import CompiledRig
 from ..spec import CharacterSpec, validate_bytes
 from ..surface.asset import SurfaceAsset
 from ..surface.correction_region import SKIN_PROGRAM
@@ -52,9 +51,10 @@ def load_reference(package: Path) -> PackageReference:
     spec = validate_bytes(spec_path.read_bytes(), str(spec_path))
     if not isinstance(spec, CharacterSpec):
         raise ValueError(f"{package}: {SPEC_PATH} is not a creature spec")
-    rig = compile_rig(spec)
-    motion = build_motion(spec, rig, build_skeleton(spec, rig))
-    return PackageReference(spec, rig, motion, read_glb(surface_path(package)))
+    # Compiled again from the shipped spec, not handed over by the build: the reference checks the
+    # package, independently of the build that made it.
+    creature = compile_creature(spec)
+    return PackageReference(spec, creature.rig, creature.motion, read_glb(surface_path(package)))
 
 
 def instance_motion(

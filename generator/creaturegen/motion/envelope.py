@@ -53,14 +53,13 @@ from ..model import layout as col
 from ..model.genome import MAX_GAIT_GENES, Genome
 from ..model.lcg import instance_yaw
 from ..model.rotations import Pose, quaternion_multiply, quaternion_to_matrix
-from ..model.skeleton import Skeleton, build_skeleton, joint_frame
-from ..rig import CompiledRig
-from ..spec import CharacterSpec
+from ..model.skeleton import Skeleton, joint_frame
+from .compiled import CompiledCreature
 from .data import MotionData
 from .derived import MotionRangeError, derive
 from .express import express
 from .providers import AnalyticWater, FlatGround, Gravity, Support, builtin_supports
-from .rig import WALKERS, build_motion
+from .rig import WALKERS
 from .simulate import Motion
 
 F64 = npt.NDArray[np.float64]
@@ -462,12 +461,12 @@ def _from_json(text: str) -> PoseEnvelope:
     )
 
 
-def pose_envelope(spec: CharacterSpec, rig: CompiledRig) -> PoseEnvelope:
-    """The envelope of ``spec``'s motion. Stepping every run takes seconds, so it is kept on disk beside
+def pose_envelope(creature: CompiledCreature) -> PoseEnvelope:
+    """The envelope of the creature's motion. Stepping every run takes seconds, so it is kept on disk beside
     the surface cache, keyed by the motion data, the rest slots and the code of this stage (floats
     round-trip exactly). The surface build hands the envelope it measured to the candidate stage; no
     module keeps one in memory."""
-    with start_pose_envelope(spec, rig) as pending:
+    with start_pose_envelope(creature) as pending:
         return pending.result()
 
 
@@ -530,17 +529,11 @@ class PendingEnvelope:
         return self._ready
 
 
-def start_pose_envelope(
-    spec: CharacterSpec, rig: CompiledRig, skeleton: Skeleton | None = None
-) -> PendingEnvelope:
+def start_pose_envelope(creature: CompiledCreature) -> PendingEnvelope:
     """``pose_envelope`` started: from memory or disk when there, else its runs stepping in forked workers
     (where fork and more than one CPU are available) until ``result()`` is asked. It must be started
-    before anything starts a GPU device's threads (forking after that is unsafe); a spec whose motion
-    cannot be stepped raises MotionRangeError here, before any work. ``skeleton`` is the caller's when it
-    has built one."""
-    if skeleton is None:
-        skeleton = build_skeleton(spec, rig)
-    data = build_motion(spec, rig, skeleton)
+    before anything starts a GPU device's threads (forking after that is unsafe)."""
+    rig, skeleton, data = creature.rig, creature.skeleton, creature.motion
     key = hashlib.sha256(
         json.dumps(data.to_json(), sort_keys=True).encode()
         + rig.slots.tobytes()

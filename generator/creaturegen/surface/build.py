@@ -24,11 +24,11 @@ import numpy.typing as npt
 from .. import __version__
 from ..candidates import DEFAULT_TIER, CandidateSet
 from ..model import layout as col
-from ..model.skeleton import Skeleton, build_skeleton
+from ..model.skeleton import Skeleton
+from ..motion.compiled import CompiledCreature
 from ..motion.envelope import PendingEnvelope, PoseEnvelope, start_pose_envelope
 from ..rig import CompiledRig
 from ..rig.signatures import signatures as rig_signatures
-from ..spec import CharacterSpec
 from . import identity
 from .asset import SurfaceAsset
 from .backend_choice import choose_backend
@@ -77,8 +77,7 @@ class SurfaceBuild:
 
 
 def build_surface(
-    spec: CharacterSpec,
-    rig: CompiledRig,
+    creature: CompiledCreature,
     *,
     tier: str = DEFAULT_TIER,
     backend: str = "auto",
@@ -87,13 +86,14 @@ def build_surface(
     strict: bool = True,
 ) -> SurfaceBuild:
     """The validated reference surface of one body at one tier (from the cache when it is there)."""
+    rig = creature.rig
     extra: dict[str, object] = {"creaturegen": __version__, "sources": identity.source_digest()}
     compiler = identity.compiler_signature(rig, tier, extra)
     geometry = rig_signatures(rig).geometryDigest
     settings = identity.settings_digest(tier, extra)
     key = _Key(geometry, settings, extra)
     if cache is None:
-        return _extract_surface(spec, rig, key, tier, backend, None, progress, strict)
+        return _extract_surface(creature, key, tier, backend, None, progress, strict)
     with cache.building(compiler, geometry, tier, settings):
         hit: CachedSurface | None = cache.lookup(compiler, geometry, tier, settings)
         if hit is not None:
@@ -102,7 +102,7 @@ def build_surface(
             return SurfaceBuild(
                 tier, dict(signature_rows(hit.sidecar)), hit.asset, hit.sidecar, cached, True, hit.folder
             )
-        return _extract_surface(spec, rig, key, tier, backend, cache, progress, strict)
+        return _extract_surface(creature, key, tier, backend, cache, progress, strict)
 
 
 @dataclass(frozen=True)
@@ -115,8 +115,7 @@ class _Key:
 
 
 def _extract_surface(
-    spec: CharacterSpec,
-    rig: CompiledRig,
+    creature: CompiledCreature,
     key: _Key,
     tier: str,
     backend: str,
@@ -129,9 +128,8 @@ def _extract_surface(
     The motion envelope is started first: its runs step in forked workers (motion/envelope.py) while this
     process samples, extracts and gates the mesh, which needs no motion; forking is safe only before the
     sampling backend has started a GPU device's threads. The skin weights are the first to wait for it."""
-    skeleton = build_skeleton(spec, rig)
-    with start_pose_envelope(spec, rig, skeleton) as pending:
-        return _extract_with(spec, rig, key, tier, backend, cache, progress, strict, pending, skeleton)
+    with start_pose_envelope(creature) as pending:
+        return _extract_with(creature, key, tier, backend, cache, progress, strict, pending)
 
 
 @dataclass
@@ -147,8 +145,7 @@ class _Stages:
 
 
 def _extract_with(
-    spec: CharacterSpec,
-    rig: CompiledRig,
+    creature: CompiledCreature,
     key: _Key,
     tier: str,
     backend: str,
@@ -156,17 +153,17 @@ def _extract_with(
     progress: Progress,
     strict: bool,
     pending: PendingEnvelope,
-    skeleton: Skeleton,
 ) -> SurfaceBuild:
     """``_extract_surface`` with its envelope under way: the stages in order, refusing after each one when
     ``strict``, then the asset and its sidecar stored in the cache."""
+    rig, skeleton = creature.rig, creature.skeleton
     t0 = time.perf_counter()
     validated, envelope = _mesh_stage(rig, skeleton, tier, backend, progress, strict, pending)
     stages = _Stages(validated.gates, validated.timings)
     ex, policy, weights = _weights_stage(rig, skeleton, validated, envelope, tier, progress, strict, stages)
     choice = _deformation_stage(rig, skeleton, ex, weights, envelope, progress, stages)
     t = time.perf_counter()
-    correction = correction_stage(spec, rig, tier, ex, weights, skeleton, choice, envelope, progress)
+    correction = correction_stage(creature, tier, ex, weights, choice, envelope, progress)
     stages.timed("correction", t)
     stages.gates += correction.gates
     if strict:

@@ -18,9 +18,9 @@ from ..field.floors import floors_for
 from ..model import layout as col
 from ..model.rotations import Pose, posed_slots
 from ..model.skeleton import Skeleton, subtree
+from ..motion.compiled import CompiledCreature
 from ..motion.envelope import PoseEnvelope
 from ..rig import CompiledRig
-from ..spec import CharacterSpec
 from .correct import CorrectionReport, correct, trust_radius
 from .deform import DeformationChoice
 from .extract import Extraction
@@ -230,11 +230,11 @@ def candidate_index(found: CandidateSet | str, rest: F64) -> tuple[npt.NDArray[n
 
 
 def tier_candidates(
-    spec: CharacterSpec, rig: CompiledRig, tier: str, envelope: PoseEnvelope | None = None
+    creature: CompiledCreature, tier: str, envelope: PoseEnvelope | None = None
 ) -> CandidateSet | str:
     """The tier's candidate programs, or why the tier has none (TierRejectedError's message)."""
     try:
-        return build_candidates(spec, rig, tier, envelope)
+        return build_candidates(creature, tier, envelope)
     except TierRejectedError as exc:
         return str(exc)
 
@@ -262,25 +262,24 @@ class CorrectionStage:
 
 
 def correction_stage(
-    spec: CharacterSpec,
-    rig: CompiledRig,
+    creature: CompiledCreature,
     tier: str,
     ex: Extraction,
     weights: SkinWeights,
-    skeleton: Skeleton,
     choice: DeformationChoice,
     envelope: PoseEnvelope,
     progress: Progress,
 ) -> CorrectionStage:
     """The correction region and each vertex's program: the tier's candidate programs (hero), or the
     one full-graph program for the vertices a skin-represented tier cannot carry by skinning alone."""
+    rig, skeleton = creature.rig, creature.skeleton
     mesh = ex.mesh
     found: CandidateSet | str
     colour: BakedColour | None = None
     contract: SkinContract | None = None
     skin_tol = TIERS[tier].skin
     if skin_tol is None:
-        found = tier_candidates(spec, rig, tier, envelope)
+        found = tier_candidates(creature, tier, envelope)
         programs, candidate_note = candidate_index(found, mesh.vertices)
     else:
         found = candidate_note = skin_note(tier)

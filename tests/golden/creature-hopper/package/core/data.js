@@ -260,7 +260,7 @@ export const CREATURE = Object.freeze({
   "registers": 13,
   "roundCone": [0, 0, 0, 0, 0, 0, 0],
   "signatures": {
-    "compilerSignature": "ad5a8021cc32d378838e70496ac256c7eaea16692249da3c686010cdefed1b2e",
+    "compilerSignature": "c86fe5b78bff3c4ad9038e9f74b1785a34832f317fb90b36c3e211105d2cccd8",
     "geometryDigest": "400b0d18a2a9f6bbbfe5b441f89767f552a4f3b4c45a368d1129d632e1d2f4f1",
     "topologySignature": "330d551e8c006f84b01459c84db69ca8c43aec5bc9d9083d3e85c291be5a68bf"
   },
