@@ -46,6 +46,7 @@ def test_examples_conform_to_the_exported_schema(path: Path) -> None:
         "unknown-field",
         "bad-colour",
         "locomotion-field-not-used",
+        "locomotion-null-field",
     ],
 )
 def test_exported_schema_rejects_what_the_gate_rejects(name: str) -> None:

@@ -272,7 +272,7 @@ def _wings(spec: CharacterSpec, rig: CompiledRig, by_part: dict[str, list[int]])
     slots = rig.slots
     wings = []
     for part in spec.parts:
-        if part.flap is None:
+        if (part.shape != "capsule" and part.shape != "cone") or part.flap is None:
             continue
         (slot,) = by_part[part.id]
         start, end = _v(slots[slot, col.A]), _v(slots[slot, col.B])
@@ -281,7 +281,7 @@ def _wings(spec: CharacterSpec, rig: CompiledRig, by_part: dict[str, list[int]])
                 part=part.id,
                 slot=slot,
                 sign=1.0 if end[0] >= start[0] else -1.0,
-                amplitude=float(part.flap),
+                amplitude=part.flap,
                 length=math.dist(start, end),
             )
         )

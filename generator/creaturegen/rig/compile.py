@@ -101,7 +101,7 @@ class CompiledRig:
 
 def effective_k(part: Part, scale: float) -> float:
     """The leaf's blend width: its k, else 0.6·r, capped by kCap; scaled like every length."""
-    k = part.k if part.k is not None else DEFAULT_K_FACTOR * float(part.r or 0.0)
+    k = part.k if part.k is not None else DEFAULT_K_FACTOR * part.r
     if part.kCap is not None:
         k = min(k, part.kCap)
     return k * scale

@@ -20,7 +20,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..spec import CharacterSpec
-from ..spec.character import Part
+from ..spec.character import LegPart, Part, RopePart
 
 LEG_DROP_MIN = 0.5
 LEG_DROP_MAX = 0.95
@@ -45,7 +45,11 @@ def _add(u: Vec, v: Vec | list[float] | None) -> Vec:
 
 def anchor_of(part: Part) -> list[float] | None:
     """The point a child hangs from, relative to the part's origin."""
-    return part.a if part.a is not None else part.offset if part.offset is not None else part.hip
+    if part.shape == "capsule" or part.shape == "cone":
+        return part.a
+    if part.shape == "leg":
+        return part.hip
+    return part.offset
 
 
 def origins(spec: CharacterSpec) -> dict[str, Vec]:
@@ -68,11 +72,11 @@ def _row(a: Vec, ra: float, b: Vec, rb: float) -> list[float]:
     return [*a, ra, *b, rb]
 
 
-def _rope(part: Part, origin: Vec) -> PartSlots:
-    n = int(part.segments or 0)
+def _rope(part: RopePart, origin: Vec) -> PartSlots:
+    n = part.segments
     start = _add(origin, part.offset)
-    step = float(part.length or 0.0) / n
-    r = float(part.r or 0.0)
+    step = part.length / n
+    r = part.r
     taper = 1.0 if part.taper is None else part.taper
     points = [_add(start, [c * step * j for c in ROPE_DIRECTION]) for j in range(n + 1)]
     radii = [r * (1.0 + (taper - 1.0) * j / n) for j in range(n + 1)]
@@ -80,9 +84,9 @@ def _rope(part: Part, origin: Vec) -> PartSlots:
     return PartSlots(np.array(rows, dtype=np.float64), ("rope",) * n)
 
 
-def _leg(part: Part, origin: Vec) -> PartSlots:
+def _leg(part: LegPart, origin: Vec) -> PartSlots:
     hip = _add(origin, part.hip)
-    upper, lower, r = float(part.upper or 0.0), float(part.lower or 0.0), float(part.r or 0.0)
+    upper, lower, r = part.upper, part.lower, part.r
     reach = upper + lower
     drop = min(max(hip[1], LEG_DROP_MIN * reach), LEG_DROP_MAX * reach)
     foot = (hip[0], hip[1] - drop, hip[2])
@@ -99,7 +103,7 @@ def part_slots(part: Part, origin: Vec) -> PartSlots:
         return _rope(part, origin)
     if part.shape == "leg":
         return _leg(part, origin)
-    r = float(part.r or 0.0)
+    r = part.r
     if part.shape == "sphere":
         centre = _add(origin, part.offset)
         return PartSlots(np.array([_row(centre, r, centre, r)]), ("sphere",))

@@ -2,16 +2,18 @@
 
 Coordinates are Y up, +Z forward, metres. A child part's coordinates are relative to its parent's origin
 plus the parent's anchor (its ``a``, else ``offset``, else ``hip``), accumulated along the parent chain.
-One model per JSON object; which fields a shape or locomotion type needs lives in the tables below, so
-the gate, the JSON Schema and the docs read the same source.
+A part is one model per ``shape`` and a locomotion one model per ``type`` (the walkers share one), in
+tagged unions: a model lists exactly the fields its shape or type requires and accepts, and the tables
+SHAPE_FIELDS and LOCOMOTION_FIELDS that the gate's rules read are derived from the models, so the gate,
+the JSON Schema and the docs read the same source.
 """
 
 from __future__ import annotations
 
 import math
-from typing import Annotated, Any, Literal
+from typing import Annotated, Literal, get_args
 
-from pydantic import ConfigDict, Field, StrictInt
+from pydantic import Field, StrictInt
 
 from .colors import Color
 from .types import (
@@ -29,34 +31,10 @@ Shape = Literal["capsule", "sphere", "cone", "rope", "leg"]
 LocomotionType = Literal[
     "none", "biped", "quadruped", "hexapod", "octopod", "walker", "hopper", "flyer", "swimmer"
 ]
-
-#: Fields every part may carry, whatever its shape.
-COMMON_PART_FIELDS = ("id", "shape", "parent", "color", "k", "kCap")
-
-#: shape -> (required fields, optional fields) beyond COMMON_PART_FIELDS.
-SHAPE_FIELDS: dict[str, tuple[tuple[str, ...], tuple[str, ...]]] = {
-    "capsule": (("a", "b", "r"), ("r2", "flap")),
-    "cone": (("a", "b", "r", "r2"), ("flap",)),
-    "sphere": (("r",), ("offset",)),
-    "rope": (("segments", "length", "r"), ("offset", "taper")),
-    "leg": (("hip", "upper", "lower", "r"), ("phase",)),
-}
+WalkerType = Literal["biped", "quadruped", "hexapod", "octopod", "walker"]
 
 #: Compiled primitive slots per part: one for round primitives, one per rope segment, two per leg.
 FIXED_SLOTS: dict[str, int] = {"capsule": 1, "cone": 1, "sphere": 1, "leg": 2}
-
-#: locomotion type -> fields it requires (no others are accepted besides ``type``).
-LOCOMOTION_FIELDS: dict[str, tuple[str, ...]] = {
-    "none": (),
-    "biped": ("speed", "stepLength", "stepHeight"),
-    "quadruped": ("speed", "stepLength", "stepHeight"),
-    "hexapod": ("speed", "stepLength", "stepHeight"),
-    "octopod": ("speed", "stepLength", "stepHeight"),
-    "walker": ("speed", "stepLength", "stepHeight"),
-    "hopper": ("speed", "hopLength", "hopHeight"),
-    "flyer": ("speed", "altitude", "radius"),
-    "swimmer": ("speed", "undulation", "buoyancy"),
-}
 
 #: locomotion type -> number of leg parts it drives; types not listed here, in WALKER_LEG_COUNTS nor in
 #: HOPPER_LEG_COUNTS accept any count.
@@ -71,7 +49,7 @@ LEG_COUNTS: dict[str, int] = {
 #: Types whose legs walk: one gait (motion/gait.py) plants and lifts their feet by phase group, so they
 #: differ only in the leg count they require. The motion reference, the envelope and the JS core read this
 #: tuple (the JS core a copy of it, pinned by the motion parity test).
-WALKERS: tuple[str, ...] = ("biped", "quadruped", "hexapod", "octopod", "walker")
+WALKERS: tuple[str, ...] = get_args(WalkerType)
 
 #: Leg counts of the generic ``walker``: left/right pairs, one to four of them. More legs than eight would
 #: outgrow a pose page's slot budget long before the gait cared.
@@ -92,49 +70,69 @@ def slots_of(shape: str, segments: int | None) -> int:
     return FIXED_SLOTS.get(shape, 0)
 
 
-def _part_schema_conditionals(schema: dict[str, Any]) -> None:
-    """Per-shape required and allowed fields in the JSON Schema, generated from SHAPE_FIELDS."""
-    rules = []
-    for shape, (required, optional) in SHAPE_FIELDS.items():
-        allowed = sorted({*COMMON_PART_FIELDS, *required, *optional})
-        rules.append(
-            {
-                "if": {"properties": {"shape": {"const": shape}}, "required": ["shape"]},
-                "then": {"required": list(required), "propertyNames": {"enum": allowed}},
-            }
-        )
-    schema["allOf"] = rules
+_TICK_RATE = "Fixed steps per second of the locomotion driver; default 60."
+_SPEED = "Ground or air speed, m/s."
 
 
-def _locomotion_schema_conditionals(schema: dict[str, Any]) -> None:
-    """Per-type required and allowed fields in the JSON Schema, generated from LOCOMOTION_FIELDS."""
-    schema["allOf"] = [
-        {
-            "if": {"properties": {"type": {"const": kind}}, "required": ["type"]},
-            "then": {"required": list(fields), "propertyNames": {"enum": ["type", "tickRate", *fields]}},
-        }
-        for kind, fields in LOCOMOTION_FIELDS.items()
-    ]
+class NoLocomotion(StrictModel):
+    """A creature that stands still."""
+
+    type: Literal["none"] = Field(description="Locomotion driver.")
+    tickRate: Literal[60, 120] | None = Field(default=None, description=_TICK_RATE)
 
 
-class Locomotion(StrictModel):
-    """How the creature moves; which fields apply depends on ``type`` (see LOCOMOTION_FIELDS)."""
+class WalkerLocomotion(StrictModel):
+    """Legs that walk by phase group: the leg count is fixed by the type (``walker``: 2, 4, 6 or 8)."""
 
-    model_config = ConfigDict(json_schema_extra=_locomotion_schema_conditionals)
+    type: WalkerType = Field(description="Locomotion driver.")
+    tickRate: Literal[60, 120] | None = Field(default=None, description=_TICK_RATE)
+    speed: NonNegative = Field(description=_SPEED)
+    stepLength: Positive = Field(description="Foot lag that triggers a step, m.")
+    stepHeight: Positive = Field(description="Swing arc apex above support, m.")
 
-    type: LocomotionType = Field(description="Locomotion driver.")
-    tickRate: Literal[60, 120] | None = Field(
-        default=None, description="Fixed steps per second of the locomotion driver; default 60."
-    )
-    speed: NonNegative | None = Field(default=None, description="Ground or air speed, m/s.")
-    stepLength: Positive | None = Field(default=None, description="Foot lag that triggers a step, m.")
-    stepHeight: Positive | None = Field(default=None, description="Swing arc apex above support, m.")
-    hopLength: Positive | None = Field(default=None, description="Horizontal distance per hop, m.")
-    hopHeight: Positive | None = Field(default=None, description="Hop apex height, m.")
-    altitude: NonNegative | None = Field(default=None, description="Flight altitude above ground, m.")
-    radius: Positive | None = Field(default=None, description="Flight circle radius, m.")
-    buoyancy: Positive | None = Field(default=None, description="Rest depth response ratio; 1 is neutral.")
-    undulation: NonNegative | None = Field(default=None, description="Body undulation amplitude, rad.")
+
+class HopperLocomotion(StrictModel):
+    """A body that hops, on its own squash or on two hind legs."""
+
+    type: Literal["hopper"] = Field(description="Locomotion driver.")
+    tickRate: Literal[60, 120] | None = Field(default=None, description=_TICK_RATE)
+    speed: NonNegative = Field(description=_SPEED)
+    hopLength: Positive = Field(description="Horizontal distance per hop, m.")
+    hopHeight: Positive = Field(description="Hop apex height, m.")
+
+
+class FlyerLocomotion(StrictModel):
+    """A flyer circling at an altitude."""
+
+    type: Literal["flyer"] = Field(description="Locomotion driver.")
+    tickRate: Literal[60, 120] | None = Field(default=None, description=_TICK_RATE)
+    speed: NonNegative = Field(description=_SPEED)
+    altitude: NonNegative = Field(description="Flight altitude above ground, m.")
+    radius: Positive = Field(description="Flight circle radius, m.")
+
+
+class SwimmerLocomotion(StrictModel):
+    """A legless swimmer that undulates."""
+
+    type: Literal["swimmer"] = Field(description="Locomotion driver.")
+    tickRate: Literal[60, 120] | None = Field(default=None, description=_TICK_RATE)
+    speed: NonNegative = Field(description=_SPEED)
+    undulation: NonNegative = Field(description="Body undulation amplitude, rad.")
+    buoyancy: Positive = Field(description="Rest depth response ratio; 1 is neutral.")
+
+
+#: How the creature moves; which fields apply depends on ``type``.
+Locomotion = Annotated[
+    NoLocomotion | WalkerLocomotion | HopperLocomotion | FlyerLocomotion | SwimmerLocomotion,
+    Field(discriminator="type"),
+]
+LOCOMOTION_MODELS: tuple[type[StrictModel], ...] = (
+    NoLocomotion,
+    WalkerLocomotion,
+    HopperLocomotion,
+    FlyerLocomotion,
+    SwimmerLocomotion,
+)
 
 
 class Genetics(StrictModel):
@@ -174,38 +172,128 @@ class Genetics(StrictModel):
     )
 
 
-class Part(StrictModel):
-    """One body part. Which fields apply depends on ``shape`` (see SHAPE_FIELDS)."""
+_ID = "Unique part id; blend refs and parents name parts by it."
+_PARENT = "Id of the parent part."
+_COLOR = "sRGB albedo: #rrggbb, #rgb or a CSS colour name (normalised to #rrggbb)."
+_K = "Blend width of this leaf; default 0.6·r."
+_K_CAP = "Upper bound on the effective blend width."
+_A = "Segment start, relative to the parent anchor, m."
+_B = "Segment end, relative to the parent anchor, m."
+_FLAP = "Wing flap amplitude, rad."
+Flap = Annotated[Number, Field(ge=0, le=math.pi / 2)]
 
-    model_config = ConfigDict(json_schema_extra=_part_schema_conditionals)
 
-    id: Ident = Field(description="Unique part id; blend refs and parents name parts by it.")
-    shape: Shape
-    parent: Ident | None = Field(default=None, description="Id of the parent part.")
-    a: Vec3 | None = Field(default=None, description="Segment start, relative to the parent anchor, m.")
-    b: Vec3 | None = Field(default=None, description="Segment end, relative to the parent anchor, m.")
-    offset: Vec3 | None = Field(default=None, description="Centre (sphere) or anchor (rope), m.")
-    r: Positive | None = Field(default=None, description="Radius at a (or the sphere radius), m.")
-    r2: Positive | None = Field(default=None, description="Radius at b (tapered capsule, cone), m.")
-    k: Positive | None = Field(default=None, description="Blend width of this leaf; default 0.6·r.")
-    kCap: Positive | None = Field(default=None, description="Upper bound on the effective blend width.")
-    color: Color | None = Field(
-        default=None, description="sRGB albedo: #rrggbb, #rgb or a CSS colour name (normalised to #rrggbb)."
-    )
-    segments: Annotated[StrictInt, Field(ge=1, le=64)] | None = Field(default=None, description="Rope slots.")
-    length: Positive | None = Field(default=None, description="Rope rest length, m.")
+class CapsulePart(StrictModel):
+    """A segment from a to b, radius r at a and r2 (default r) at b."""
+
+    id: Ident = Field(description=_ID)
+    shape: Literal["capsule"]
+    parent: Ident | None = Field(default=None, description=_PARENT)
+    a: Vec3 = Field(description=_A)
+    b: Vec3 = Field(description=_B)
+    r: Positive = Field(description="Radius at a, m.")
+    r2: Positive | None = Field(default=None, description="Radius at b (tapered capsule), m.")
+    flap: Flap | None = Field(default=None, description=_FLAP)
+    color: Color | None = Field(default=None, description=_COLOR)
+    k: Positive | None = Field(default=None, description=_K)
+    kCap: Positive | None = Field(default=None, description=_K_CAP)
+
+
+class ConePart(StrictModel):
+    """A segment from a to b, radius r at a and r2 at b."""
+
+    id: Ident = Field(description=_ID)
+    shape: Literal["cone"]
+    parent: Ident | None = Field(default=None, description=_PARENT)
+    a: Vec3 = Field(description=_A)
+    b: Vec3 = Field(description=_B)
+    r: Positive = Field(description="Radius at a, m.")
+    r2: Positive = Field(description="Radius at b, m.")
+    flap: Flap | None = Field(default=None, description=_FLAP)
+    color: Color | None = Field(default=None, description=_COLOR)
+    k: Positive | None = Field(default=None, description=_K)
+    kCap: Positive | None = Field(default=None, description=_K_CAP)
+
+
+class SpherePart(StrictModel):
+    """A ball of radius r centred at offset (default the origin)."""
+
+    id: Ident = Field(description=_ID)
+    shape: Literal["sphere"]
+    parent: Ident | None = Field(default=None, description=_PARENT)
+    r: Positive = Field(description="Sphere radius, m.")
+    offset: Vec3 | None = Field(default=None, description="Centre, relative to the parent anchor, m.")
+    color: Color | None = Field(default=None, description=_COLOR)
+    k: Positive | None = Field(default=None, description=_K)
+    kCap: Positive | None = Field(default=None, description=_K_CAP)
+
+
+class RopePart(StrictModel):
+    """A chain of equal segments laid along -Z from its anchor, tapering from r to r·taper."""
+
+    id: Ident = Field(description=_ID)
+    shape: Literal["rope"]
+    parent: Ident | None = Field(default=None, description=_PARENT)
+    segments: Annotated[StrictInt, Field(ge=1, le=64)] = Field(description="Rope slots.")
+    length: Positive = Field(description="Rope rest length, m.")
+    r: Positive = Field(description="Radius at the anchor, m.")
+    offset: Vec3 | None = Field(default=None, description="Anchor, relative to the parent anchor, m.")
     taper: Annotated[Number, Field(gt=0, le=1)] | None = Field(
         default=None, description="Rope tip radius as a fraction of r."
     )
-    hip: Vec3 | None = Field(default=None, description="Leg hip joint, relative to the parent anchor, m.")
-    upper: Positive | None = Field(default=None, description="Thigh length, m.")
-    lower: Positive | None = Field(default=None, description="Shin length, m.")
+    color: Color | None = Field(default=None, description=_COLOR)
+    k: Positive | None = Field(default=None, description=_K)
+    kCap: Positive | None = Field(default=None, description=_K_CAP)
+
+
+class LegPart(StrictModel):
+    """A two-bone leg hanging from its hip, knee bent toward +Z."""
+
+    id: Ident = Field(description=_ID)
+    shape: Literal["leg"]
+    parent: Ident | None = Field(default=None, description=_PARENT)
+    hip: Vec3 = Field(description="Leg hip joint, relative to the parent anchor, m.")
+    upper: Positive = Field(description="Thigh length, m.")
+    lower: Positive = Field(description="Shin length, m.")
+    r: Positive = Field(description="Leg radius, m.")
     phase: Annotated[Number, Field(ge=0, lt=1)] | None = Field(
         default=None, description="Gait phase, cycles."
     )
-    flap: Annotated[Number, Field(ge=0, le=math.pi / 2)] | None = Field(
-        default=None, description="Wing flap amplitude, rad."
-    )
+    color: Color | None = Field(default=None, description=_COLOR)
+    k: Positive | None = Field(default=None, description=_K)
+    kCap: Positive | None = Field(default=None, description=_K_CAP)
+
+
+#: One body part; which fields apply depends on ``shape``.
+Part = Annotated[CapsulePart | SpherePart | ConePart | RopePart | LegPart, Field(discriminator="shape")]
+PART_MODELS: tuple[type[StrictModel], ...] = (CapsulePart, SpherePart, ConePart, RopePart, LegPart)
+
+#: Fields every part may carry, whatever its shape.
+COMMON_PART_FIELDS = ("id", "shape", "parent", "color", "k", "kCap")
+
+
+def _fields_by_tag(
+    models: tuple[type[StrictModel], ...], tag: str, common: tuple[str, ...]
+) -> dict[str, tuple[tuple[str, ...], tuple[str, ...]]]:
+    """tag value -> (required fields, optional fields) beyond ``common``, read from the models."""
+    table: dict[str, tuple[tuple[str, ...], tuple[str, ...]]] = {}
+    for model in models:
+        own = {name: info for name, info in model.model_fields.items() if name not in common}
+        required = tuple(name for name, info in own.items() if info.is_required())
+        optional = tuple(name for name, info in own.items() if not info.is_required())
+        for value in get_args(model.model_fields[tag].annotation):
+            table[value] = (required, optional)
+    return table
+
+
+#: shape -> (required fields, optional fields) beyond COMMON_PART_FIELDS, read from the part models.
+SHAPE_FIELDS = _fields_by_tag(PART_MODELS, "shape", COMMON_PART_FIELDS)
+
+#: locomotion type -> fields it requires (no others are accepted besides ``type`` and ``tickRate``).
+LOCOMOTION_FIELDS: dict[str, tuple[str, ...]] = {
+    kind: required
+    for kind, (required, _) in _fields_by_tag(LOCOMOTION_MODELS, "type", ("type", "tickRate")).items()
+}
 
 
 class Ref(StrictModel):
@@ -274,4 +362,4 @@ class CharacterSpec(StrictModel):
 
     @property
     def slot_count(self) -> int:
-        return sum(slots_of(p.shape, p.segments) for p in self.parts)
+        return sum(slots_of(p.shape, p.segments if isinstance(p, RopePart) else None) for p in self.parts)

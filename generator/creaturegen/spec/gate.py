@@ -19,6 +19,7 @@ from pydantic import BaseModel, ValidationError
 from .character import CharacterSpec
 from .creature_rules import check_creature
 from .errors import WHOLE_SPEC, SpecError, SpecValidationError, shown
+from .flat import unfold_unions
 from .frost import FrostEffectSpec
 from .messages import describe
 from .places import place
@@ -125,11 +126,15 @@ def check(raw: object) -> tuple[Spec | None, list[SpecError]]:
     errors = [SpecError(place(raw, loc), message) for loc, message in _scan(raw)]
     spec: Spec | None = None
     hidden = 0
+    held: list[SpecError] = []
     try:
         spec = model.model_validate(raw)
     except ValidationError as exc:
         vocabulary = _vocabulary(model)
         found = exc.errors(include_url=False)
+        if model is CharacterSpec:
+            found, union_only = unfold_unions(raw, found)
+            held = [SpecError(place(raw, e["loc"]), describe(e, vocabulary)) for e in union_only[:MAX_ERRORS]]
         # Each message may search the vocabulary for a near name: only the ones that are shown are made.
         room = max(MAX_ERRORS - len(errors), 0)
         hidden += max(len(found) - room, 0)
@@ -139,7 +144,8 @@ def check(raw: object) -> tuple[Spec | None, list[SpecError]]:
             errors.append(SpecError(where, message))
     if model is CharacterSpec:
         errors += check_creature(raw)
-    unique = _first_per_place(errors)
+    # A union error no flat model nor rule explains is still an error: a refusal always names one.
+    unique = _first_per_place(errors or held)
     hidden += max(len(unique) - MAX_ERRORS, 0)
     unique = unique[:MAX_ERRORS]
     if hidden:
