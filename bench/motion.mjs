@@ -31,7 +31,7 @@ const data = core.CREATURE;
 function bodies(motionData, count) {
   const out = [];
   for (let i = 0; i < count; i++) {
-    out.push(core.createMotion(motionData, data.lcg, { water: core.createAnalyticWater(), seed: i + 1, position: [i * 3 * data.bodyScale, 0, 0] }));
+    out.push(core.createMotion(motionData, core.LCG, { water: core.createAnalyticWater(), seed: i + 1, position: [i * 3 * data.bodyScale, 0, 0] }));
   }
   return out;
 }

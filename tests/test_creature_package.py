@@ -202,12 +202,13 @@ def test_lint_finds_nothing_in_the_package(hopper: Path) -> None:
 
 
 def test_deform_storage_layout_is_one_definition_in_python_and_js(hopper: Path) -> None:
-    """The build report's deformBytesPerBody and the runtime's page clamp use the same stride."""
+    """The build report's deformBytesPerBody and the runtime's page clamp use the same stride: the shipped
+    module's own constant, which tests/test_runtime_constants.py pins to the plan's."""
     from creaturegen.creature.plan import DEFORM_STRIDE
 
     js = (hopper / "tsl" / "deform.js").read_text()
-    assert "export const DEFORM_STRIDE = CREATURE.deformStride;" in js
-    assert f'"deformStride": {DEFORM_STRIDE}' in (hopper / "core" / "data.js").read_text()
+    assert f"export const DEFORM_STRIDE = {DEFORM_STRIDE};" in js
+    assert "deformStride" not in (hopper / "core" / "data.js").read_text()
     workload = json.loads((hopper / "build-report.json").read_text())["workload"]
     assert workload["deformBytesPerBody"] == workload["vertices"] * DEFORM_STRIDE * 16
 

@@ -5,6 +5,7 @@ import * as THREE from 'three/webgpu';
 import {
   CREATURE,
   DEBUG_MODES,
+  LCG,
   createAnalyticWater,
   createCreaturePopulation,
   createMotion,
@@ -24,7 +25,7 @@ export async function typed(renderer: THREE.WebGPURenderer, scene: THREE.Scene, 
   const pose: Float32Array = await diagnostics.readPose(id);
   const staged: Float32Array = diagnostics.stagedPose(id);
   const slug: string = CREATURE.slug;
-  const motion = createMotion(CREATURE.motion, CREATURE.lcg, { seed: 1 });
+  const motion = createMotion(CREATURE.motion, LCG, { seed: 1 });
   const frost = await createFrostEffect(renderer, scene, camera);
   frost.update(0, 1 / 60);
   frost.render();

@@ -22,8 +22,8 @@ const data = core.CREATURE;
 
 test('the package carries the constants the reference used', () => {
   assert.equal(data.slots.length, ref.slotCount);
-  assert.equal(data.poseRows, ref.constants.poseRows);
-  assert.deepEqual(data.lcg, ref.constants.lcg);
+  assert.equal(core.POSE_ROWS, ref.constants.poseRows);
+  assert.deepEqual({ ...core.LCG }, ref.constants.lcg);
   assert.deepEqual(data.roundCone, ref.constants.roundCone);
   assert.equal(data.maxParts, data.slotCount + 1, 'one extra part per instance holds the root rows');
 });
@@ -31,7 +31,7 @@ test('the package carries the constants the reference used', () => {
 test('LCG draws are exactly equal', () => {
   for (const { seed, draws } of ref.lcg) {
     let state = seed >>> 0;
-    const got = draws.map(() => (state = core.lcgNext(state, data.lcg.a, data.lcg.c)));
+    const got = draws.map(() => (state = core.lcgNext(state, core.LCG.a, core.LCG.c)));
     assert.deepEqual(got, draws, `seed ${seed}`);
   }
 });
@@ -39,13 +39,13 @@ test('LCG draws are exactly equal', () => {
 test('instanceYaw matches to 1e-12', () => {
   for (const { seed, mixed, yaw } of ref.instances) {
     assert.equal(core.mixSeed(seed), mixed, `seed ${seed}: mixSeed`);
-    const got = core.instanceYaw(seed, data.lcg);
+    const got = core.instanceYaw(seed, core.LCG);
     assert.ok(Math.abs(got - yaw) <= 1e-12, `seed ${seed}: yaw ${got} vs ${yaw}`);
   }
 });
 
 test('pose rows and root rows from the motion core match the reference bit for bit', (t) => {
-  const rowFloats = ref.slotCount * data.poseRows * 4;
+  const rowFloats = ref.slotCount * core.POSE_ROWS * 4;
   const total = rowFloats + 8;
   const pad = 8; // write at a non-zero base: the base offset is honoured, the rest of the page untouched
   const page = new Float32Array(pad + total + pad).fill(-7);
@@ -56,9 +56,9 @@ test('pose rows and root rows from the motion core match the reference bit for b
   const p = new Float64Array(3);
   let frames = 0, minSquash = Infinity, maxSquash = -Infinity;
   for (const { seed, size, frames: expected } of ref.cases) {
-    const motion = core.createMotion(data.motion, data.lcg, { water: core.createAnalyticWater(), seed });
+    const motion = core.createMotion(data.motion, core.LCG, { water: core.createAnalyticWater(), seed });
     assert.equal(motion.size, size, `seed ${seed}: size`);
-    const colours = core.genomeColours(data, core.drawGenome(seed, data.lcg), new Float64Array(3 * ref.slotCount));
+    const colours = core.genomeColours(data, core.drawGenome(seed, core.LCG), new Float64Array(3 * ref.slotCount));
     for (const frame of expected) {
       if (frame.tick) motion.step();
       assert.equal(motion.tick, frame.tick);
@@ -79,7 +79,7 @@ test('pose rows and root rows from the motion core match the reference bit for b
       maxSquash = Math.max(maxSquash, root[5]);
       for (let s = 0; s < ref.slotCount; s++) {
         for (let end = 0; end < 2; end++) {
-          const o = pad + s * data.poseRows * 4 + end * 4;
+          const o = pad + s * core.POSE_ROWS * 4 + end * 4;
           // The squashed sphere is an ellipsoid: semi-axes r/√s across (unchanged by the yaw) and r·s up.
           const across = page[o + 3] * k, up = page[o + 3] * root[5];
           const x = page[o] * k, y = page[o + 1] * root[5], z = page[o + 2] * k;

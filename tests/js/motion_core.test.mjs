@@ -20,7 +20,7 @@ const data = core.CREATURE.motion;
 const L = ref.bodyScale;
 
 function spawn(support, seed) {
-  return core.createMotion(data, core.CREATURE.lcg, { support: core.builtinSupports()[support], water: core.createAnalyticWater(), seed });
+  return core.createMotion(data, core.LCG, { support: core.builtinSupports()[support], water: core.createAnalyticWater(), seed });
 }
 
 function worst(actual, expected, what) {
@@ -70,7 +70,7 @@ test('JS core matches Python after 1000 ticks on every support surface', () => {
 
 test('derived numbers match', () => {
   // From the individual of case 0 (its size and gait genes scale the authored data), as Python derived them.
-  const individual = core.express(data, core.drawGenome(ref.cases[0].seed, core.CREATURE.lcg));
+  const individual = core.express(data, core.drawGenome(ref.cases[0].seed, core.LCG));
   const d = core.derive(individual, [0, -core.STANDARD_GRAVITY, 0]);
   const py = ref.cases[0].derived;
   for (const [k, v] of Object.entries(py)) {
@@ -108,6 +108,6 @@ test('a swimmer missing a required water channel is refused, not zero-filled', (
   const kept = core.SWIMMER_CHANNELS.slice(1);
   const water = core.createAnalyticWater({ channels: kept });
   if (data.type !== 'swimmer') return;
-  assert.throws(() => core.createMotion(data, core.CREATURE.lcg, { water }), core.TierRefusedError);
-  assert.throws(() => core.createMotion(data, core.CREATURE.lcg, {}), /no WaterSurfaceProvider/);
+  assert.throws(() => core.createMotion(data, core.LCG, { water }), core.TierRefusedError);
+  assert.throws(() => core.createMotion(data, core.LCG, {}), /no WaterSurfaceProvider/);
 });

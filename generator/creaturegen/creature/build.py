@@ -31,7 +31,7 @@ def build_report(plan: dict[str, Any], surface: SurfaceBuild) -> dict[str, Any]:
         "tier": plan["tier"],
         "workload": plan["workload"],
         "methods": plan["methods"],
-        "debugModes": plan["runtime"]["debugModes"],
+        "debugModes": plan["types"]["debugMode"],
         "candidateNote": plan["runtime"]["candidateNote"],
         "surface": {
             "passed": surface.passed,

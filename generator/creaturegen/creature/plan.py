@@ -19,7 +19,6 @@ from ..field.floors import floors_for
 from ..field.primitives import GRADIENT_FLOOR, slot_uses_round_cone
 from ..model import layout as col
 from ..model.genome import genetics_data, slot_lab
-from ..model.lcg import LCG
 from ..model.skeleton import Skeleton
 from ..motion.compiled import CompiledCreature
 from ..motion.data import MotionData
@@ -35,9 +34,11 @@ from .pose import POSE_ROWS
 from .runtime import CorrectionData, CreatureData, MeshCounts, data_declarations
 from .tape import Tape, compile_tape
 
-#: The runtime's debug views (lab `setDebugMode`); "shell" is the diagnostic capsule shell.
+#: The runtime's debug views (lab `setDebugMode`; tsl/material.js DEBUG_MODES); "shell" is the diagnostic
+#: capsule shell.
 DEBUG_MODES = ("off", "skin-only", "distance", "weights", "normals", "candidates", "shell")
-#: vec4 per vertex in a page's deform storage (templates/creature/tsl/deform.js DEFORM_STRIDE).
+#: vec4 per vertex in a page's deform storage (templates/creature/tsl/deform.js DEFORM_STRIDE, the same
+#: number: tests/test_runtime_constants.py).
 DEFORM_STRIDE = 3
 #: The three.js release the templates are written against: TSL names and node semantics move between
 #: releases, so the package pins its peer to it and refuses another REVISION at run time.
@@ -169,11 +170,9 @@ def _runtime(
         slot_count=rig.slot_count,
         # One extra "part" per instance: the root rows (position + alive, yaw cos/sin + squash + size).
         max_parts=rig.slot_count + 1,
-        pose_rows=POSE_ROWS,
         slots=tuple(tuple(row) for row in rig.slots.tolist()),
         slot_names=tuple(skeleton.names),
         round_cone=tuple(int(x) for x in slot_uses_round_cone(rig.slots)),
-        lcg=LCG,
         # Colour genes mutate these OKLab coordinates of the authored colours (model/genome.py).
         genetics=genetics_data(spec.genetics),
         slot_lab=tuple((big_l, a, b) for big_l, a, b in slot_lab(rig.slots[:, col.RGB])),
@@ -182,8 +181,6 @@ def _runtime(
         program_data=tuple(program_data(tapes)),
         program_count=len(tapes),
         full_program=len(tapes) - 1,
-        no_program=NO_PROGRAM,
-        skin_program=SKIN_PROGRAM,
         registers=max(len(t) for t in tapes),
         candidate_note=note,
         gradient_floor=GRADIENT_FLOOR,
@@ -191,8 +188,6 @@ def _runtime(
         k_floor=floors.k_floor,
         correction=CorrectionData(correction.DEFAULT_BUDGET, correction.EARLY_OUT, correction.GRADIENT_FLOOR),
         mesh=MeshCounts(asset.vertex_count, int(asset.indices.size // 3)),
-        debug_modes=DEBUG_MODES,
-        deform_stride=DEFORM_STRIDE,
     )
 
 

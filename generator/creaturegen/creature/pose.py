@@ -36,7 +36,8 @@ from ..rig import CompiledRig
 
 F64 = npt.NDArray[np.float64]
 
-#: Rows of four floats per slot in a pose page: (a, ra), (b, rb), (k, rgb), quaternion xyzw, (t, roundCone).
+#: Rows of four floats per slot in a pose page: (a, ra), (b, rb), (k, rgb), quaternion xyzw, (t, roundCone);
+#: the shipped core/pose.js exports the same POSE_ROWS.
 POSE_ROWS: Final = 5
 
 

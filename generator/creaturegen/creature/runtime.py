@@ -1,4 +1,7 @@
-"""CREATURE as a typed record: every number the package's runtime reads, which core/data.js ships.
+"""CREATURE as a typed record: every number of this creature and build the package's runtime reads, which
+core/data.js ships. Constants of the runtime's own code (the pose and deform layouts, the candidate codes,
+the LCG, the debug views) are the JS modules' exported constants instead, pinned to their Python twins by
+tests/test_runtime_constants.py.
 
 creature/plan.py builds it; its JSON (model/record.py ``to_json``) is the plan's ``runtime`` and the text of
 core/data.js, key for key as the untyped dict it replaced. core/index.d.ts declares its interfaces by
@@ -14,7 +17,6 @@ from typing import Annotated
 
 from ..emit.tstypes import declarations
 from ..model.genome import ColourGenetics
-from ..model.lcg import Lcg
 from ..model.record import JsonRecord, TsName
 from ..motion.data import MotionData, Vec3
 
@@ -60,12 +62,10 @@ class CreatureData(JsonRecord):
     slot_count: int
     max_parts: int
     """Pose-texture parts per instance: every slot, and one for the root rows."""
-    pose_rows: int
     slots: tuple[tuple[float, ...], ...]
     """Rest slot table, one row of 12 numbers per slot."""
     slot_names: tuple[str, ...]
     round_cone: tuple[int, ...]
-    lcg: Lcg
     genetics: ColourGenetics
     slot_lab: tuple[Vec3, ...]
     """OKLab coordinates of every slot's authored colour, which the colour genes mutate."""
@@ -74,10 +74,6 @@ class CreatureData(JsonRecord):
     program_data: tuple[float, ...]
     program_count: int
     full_program: int
-    no_program: int
-    skin_program: int
-    """The candidate code of a vertex that evaluates no field (a skin-represented tier): skinned position
-    and normal, baked colour."""
     registers: int
     candidate_note: str
     gradient_floor: float
@@ -85,8 +81,6 @@ class CreatureData(JsonRecord):
     k_floor: float
     correction: CorrectionData
     mesh: MeshCounts
-    debug_modes: tuple[Annotated[str, TsName("DebugMode")], ...]
-    deform_stride: int
 
 
 @cache

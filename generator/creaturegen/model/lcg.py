@@ -4,26 +4,12 @@ so the reference reproduces any spawned instance from its seed (no Math.random a
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
 from typing import Final
 
-from .record import JsonRecord
-
-#: Numerical Recipes LCG, modulo 2³².
+#: Numerical Recipes LCG, modulo 2³²: state' = (a·state + c) mod 2^32. The shipped core/lcg.js exports the
+#: same LCG_A and LCG_C (tests/test_runtime_constants.py), so the JS streams are this module's.
 LCG_A: Final = 1664525
 LCG_C: Final = 1013904223
-
-
-@dataclass(frozen=True, slots=True)
-class Lcg(JsonRecord):
-    """The LCG every instance stream uses: state' = (a·state + c) mod 2^32."""
-
-    a: int
-    c: int
-
-
-#: The constants as the runtime reads them (CREATURE.lcg), so the JS streams are this module's.
-LCG: Final = Lcg(LCG_A, LCG_C)
 
 
 def lcg_next(state: int) -> int:

@@ -50,7 +50,8 @@ F64 = npt.NDArray[np.float64]
 #: The skin alone must stay within this fraction of L of the posed field over the sweep; vertices that do
 #: not are the correction region.
 SKIN_ERROR_FACTOR = DISTANCE_TOL
-#: Candidate index written for a vertex no candidate region covers (it is never corrected).
+#: Candidate index written for a vertex no candidate region covers (it is never corrected); the shipped
+#: tsl/body.js exports the same NO_PROGRAM and SKIN_PROGRAM.
 NO_PROGRAM = 65535
 #: Candidate index of a vertex that evaluates no field at all (a skin-represented tier, TIER_REPRESENTATION):
 #: skinned position and normal, colour from its baked colour weights.

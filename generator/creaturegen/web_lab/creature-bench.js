@@ -295,7 +295,7 @@ async function main() {
         userAgent: navigator.userAgent,
         slug: data.slug, tier: data.tier, slots: data.slotCount, registers: data.registers, programs: data.programCount,
         vertices: data.mesh.vertices, triangles: data.mesh.triangles, capacity, pageSize: pop.pageSize, pages: pop.pages.length,
-        floatsPerInstance: data.maxParts * data.poseRows * 4, bodyScale: L, canvas: [width, height],
+        floatsPerInstance: data.maxParts * pkg.POSE_ROWS * 4, bodyScale: L, canvas: [width, height],
         drawingBuffer: [canvas.width, canvas.height], spacing, frameBodies, fdStep: step,
         shadows, shadowMapSize: shadows ? [sun.shadow.mapSize.x, sun.shadow.mapSize.y] : null, signatures: data.signatures,
       };

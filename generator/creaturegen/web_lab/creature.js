@@ -389,13 +389,13 @@ async function main() {
       const rows = await diag.readPose(i);
       const motion = pop.motion(i);
       motion.feet(feet);
-      const r = data.slotCount * data.poseRows * 4;
+      const r = data.slotCount * pkg.POSE_ROWS * 4;
       const root = [rows[r], rows[r + 1], rows[r + 2], rows[r + 4], rows[r + 5], rows[r + 6]];
       const k = 1 / Math.sqrt(root[5]);
       const out = [];
       for (let l = 0; l < legs.length; l++) {
         const leg = motion.data.legs[l]; // the individual's leg: its size scales the rest foot the rows draw
-        const o = leg.lower * data.poseRows * 4;
+        const o = leg.lower * pkg.POSE_ROWS * 4;
         const q = new Float64Array([rows[o + 12], rows[o + 13], rows[o + 14], rows[o + 15]]);
         const p = new Float64Array(3);
         pkg.rotate(q, 0, leg.foot, 0, p, 0);

@@ -1,11 +1,11 @@
 // Pure-JS entry (no three imports): creature data, LCG, pose rows, the .glb reader, stateHash, and the
 // locomotion core (driver, providers, motion) that poses every body.
 export { CREATURE } from './data.js';
-export { lcgNext, instanceYaw, mixSeed } from './lcg.js';
+export { LCG, LCG_A, LCG_C, lcgNext, instanceYaw, mixSeed } from './lcg.js';
 export {
   GENOME_LENGTH, SIZE_DRAW, drawGenome, express, expressGait, expressSize, genomeColours, individualSize,
 } from './genome.js';
-export { rootBounds, rotate, writePoseRows, writeRootRows } from './pose.js';
+export { POSE_ROWS, rootBounds, rotate, writePoseRows, writeRootRows } from './pose.js';
 export { hashBytes } from './hash.js';
 export { parseGlb } from './glb.js';
 // The surface loader's checks: the .glb's signatures and three's REVISION, each with a named error.

@@ -1,6 +1,12 @@
 // The seeded LCG (Numerical Recipes, modulo 2^32): the only source of variation in this package.
 // Integer arithmetic, so Python's reference (model/lcg.py) reproduces every draw exactly.
 
+/** The multiplier and increment of state' = (a·state + c) mod 2^32 (creaturegen model/lcg.py LCG_A, LCG_C). */
+export const LCG_A = 1664525;
+export const LCG_C = 1013904223;
+/** The LCG every instance stream uses, as drawGenome, instanceYaw and createMotion take it. */
+export const LCG = Object.freeze({ a: LCG_A, c: LCG_C });
+
 /** Next state of the LCG; `state` is an unsigned 32-bit integer. */
 export function lcgNext(state, a, c) {
   return (Math.imul(a, state >>> 0) + c) >>> 0;

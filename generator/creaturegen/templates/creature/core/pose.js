@@ -7,6 +7,10 @@ import { rotate } from './motion/quat.js';
 
 export { rotate };
 
+/** vec4 rows per slot in a pose page: (a, ra), (b, rb), (k, rgb), quaternion xyzw, (t, roundCone)
+ * (creaturegen creature/pose.py POSE_ROWS). */
+export const POSE_ROWS = 5;
+
 /**
  * Write one instance's slot rows (POSE_ROWS vec4 per slot) into `target` at float offset `base`:
  * (a, ra), (b, rb), (k, rgb), quaternion xyzw, (t, roundCone), from per-slot `quats` (xyzw) and `trans`,
@@ -17,7 +21,7 @@ export { rotate };
  */
 export function writePoseRows(data, quats, trans, colours, co, tmp, target, base, bounds, size = 1) {
   const slots = data.slots;
-  const rows = data.poseRows;
+  const rows = POSE_ROWS;
   let minX = Infinity, minY = Infinity, minZ = Infinity, maxX = -Infinity, maxY = -Infinity, maxZ = -Infinity;
   for (let s = 0; s < slots.length; s++) {
     const row = slots[s];

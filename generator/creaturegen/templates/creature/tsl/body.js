@@ -1,7 +1,7 @@
 // The body path of one vertex, shared by the deform pre-pass (deform.js), the diagnostics kernels and
 // the lab's baseline: skin by the joint's method, correct where the build said so, then one field
 // evaluation at the final position for the normal, the distance and the albedo; or, for a vertex of a
-// skin-represented tier (program CREATURE.skinProgram), no field at all: skinned position and normal,
+// skin-represented tier (program SKIN_PROGRAM), no field at all: skinned position and normal,
 // baked colour.
 //
 // An individual's size s (root row 1 .w, core/genome.js) is a similarity of the certified body: the rest
@@ -9,19 +9,27 @@
 // pose rows already hold the scaled slots (core/pose.js) and the field scales its blend widths (field.js),
 // so the path below is the unit body's times s.
 import { If, float, int, select, vec3 } from 'three/tsl';
+import { POSE_ROWS } from '../core/pose.js';
 import { createField } from './field.js';
 import { createSkin } from './skin.js';
 
-/** Layout constants every node graph of this creature shares (from CREATURE). */
+/** The candidate code of a vertex no candidate region covers: never corrected, it runs the full program
+ * (creaturegen surface/correction_region.py NO_PROGRAM). */
+export const NO_PROGRAM = 65535;
+/** The candidate code of a vertex that evaluates no field (a skin-represented tier): skinned position and
+ * normal, baked colour (creaturegen surface/correction_region.py SKIN_PROGRAM). */
+export const SKIN_PROGRAM = 65534;
+
+/** Layout constants every node graph of this creature shares (from CREATURE and this runtime's own). */
 export function layoutOf(data) {
   return {
-    rows: data.poseRows,
+    rows: POSE_ROWS,
     maxParts: data.maxParts,
     slotCount: data.slotCount,
     registers: data.registers,
     fullProgram: data.fullProgram,
-    noProgram: data.noProgram,
-    skinProgram: data.skinProgram,
+    noProgram: NO_PROGRAM,
+    skinProgram: SKIN_PROGRAM,
     gradientFloor: data.gradientFloor,
     tiny: data.tiny,
     kFloor: data.kFloor,
@@ -44,7 +52,7 @@ export function bodyFunctions(layout, pose, programs) {
 /**
  * One vertex through the whole body path, inline in a Fn: skin, correct (unless skin-only), then one
  * field evaluation at the final position for the normal, the distance and (with `colour`) the albedo.
- * A vertex whose program is CREATURE.skinProgram (a skin-represented tier) evaluates no field at all: its
+ * A vertex whose program is SKIN_PROGRAM (a skin-represented tier) evaluates no field at all: its
  * skinned position, its skinned rest normal (in the gradient slot) and, with `colour`, its baked colour;
  * distance and accepted are 0. Inputs are nodes so the vertex stage (attributes) and the diagnostics
  * kernels (storage) share it. `program` is the program the field runs (full for noProgram and

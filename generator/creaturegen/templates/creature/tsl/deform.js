@@ -5,16 +5,16 @@
 // evaluated twice in a frame (a vertex stage would re-run the whole path per pass, and per re-shaded
 // vertex on a rasteriser without a post-transform cache, such as SwiftShader).
 import { Fn, If, float, instanceIndex, instancedArray, int, storage, uniform, vec4 } from 'three/tsl';
-import { CREATURE } from '../core/data.js';
 import { bodyVertex } from './body.js';
 
-/** vec4 per drawn vertex: (position, distance), (gradient, accepted), (albedo, program); the plan's number,
- * which the build report's deformBytesPerBody also uses. A skinProgram vertex stores its skinned normal as
- * the gradient, distance and accepted 0, and CREATURE.skinProgram as its program. */
-export const DEFORM_STRIDE = CREATURE.deformStride;
+/** vec4 per drawn vertex: (position, distance), (gradient, accepted), (albedo, program); creaturegen's
+ * DEFORM_STRIDE (creature/plan.py), which the build report's deformBytesPerBody uses. A SKIN_PROGRAM
+ * vertex stores its skinned normal as the gradient, distance and accepted 0, and SKIN_PROGRAM as its
+ * program. */
+export const DEFORM_STRIDE = 3;
 /** vec4 per rest vertex: (rest, 0), slots, weights, (centre of rotation, 0), (method, trust, program, 0),
  * (rest normal, 0), colour slots, colour weights (the last two zero unless the tier is skin-represented:
- * they colour the vertices whose program is CREATURE.skinProgram, which evaluate no field). */
+ * they colour the vertices whose program is SKIN_PROGRAM, which evaluate no field). */
 export const RECORD_STRIDE = 8;
 
 /** The rest-vertex records (one read-only storage node shared by every page and kernel). */

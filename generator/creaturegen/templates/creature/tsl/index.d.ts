@@ -58,11 +58,15 @@ export interface VertexInputs {
 export interface BodyVertex {
   skinned: Node; position: Node; accepted: Node; program: Node; code: Node; gradient: Node; distance: Node; colour: Node | null;
 }
+/** The candidate code of a vertex no candidate region covers (it runs the full program). */
+export const NO_PROGRAM: number;
+/** The candidate code of a vertex that evaluates no field (a skin-represented tier). */
+export const SKIN_PROGRAM: number;
 export function layoutOf(data: CreatureData): Layout;
 export function bodyFunctions(layout: Layout, pose: PoseStorage, programs: PoseStorage): BodyFunctions;
 export function bodyVertex(layout: Layout, fns: BodyFunctions, inputs: VertexInputs & { base: Node; skinOnly: boolean; colour?: boolean }): BodyVertex;
 
-/** vec4 per drawn vertex in a page's deform storage (CREATURE.deformStride). */
+/** vec4 per drawn vertex in a page's deform storage: (position, distance), (gradient, accepted), (albedo, program). */
 export const DEFORM_STRIDE: number;
 /** vec4 per rest vertex in the vertex records. */
 export const RECORD_STRIDE: number;

@@ -2,7 +2,7 @@
 // the diagnostic shell (the readback diagnostics are their own entry, `<package>/diagnostics`).
 export { OP, createField, rootSize } from './field.js';
 export { METHOD, createSkin, rotate } from './skin.js';
-export { bodyFunctions, bodyVertex, layoutOf } from './body.js';
+export { NO_PROGRAM, SKIN_PROGRAM, bodyFunctions, bodyVertex, layoutOf } from './body.js';
 export {
   DEFORM_STRIDE, RECORD_STRIDE, createDeformKernel, deformStorage, deformView, dispatchDeform, recordInputs, vertexRecords,
 } from './deform.js';

@@ -4,18 +4,17 @@
 // instanceMatrix, so nothing is applied twice); the normal takes the transform's inverse transpose and goes
 // to normalLocal, the local-space slot r185 expects. The shadow pass uses this positionNode too (three's
 // default), so it casts the stored surface that is seen. A vertex of a skin-represented tier (program
-// CREATURE.skinProgram) stores its skinned normal, baked colour and distance 0 there: every view reads it
+// SKIN_PROGRAM, body.js) stores its skinned normal, baked colour and distance 0 there: every view reads it
 // the same way (the 'distance' view shows it on the surface, 'candidates' gives it its own colour).
 import * as THREE from 'three/webgpu';
 import {
   Fn, attribute, clamp, float, fract, instanceIndex, int, mix, normalLocal, normalize, select, sin,
   varyingProperty, vec3, vertexIndex,
 } from 'three/tsl';
-import { CREATURE } from '../core/data.js';
 import { DEFORM_STRIDE } from './deform.js';
 
-/** The runtime's debug views, as the build plan lists them. */
-export const DEBUG_MODES = Object.freeze([...CREATURE.debugModes]);
+/** The runtime's debug views (creaturegen creature/plan.py DEBUG_MODES); 'shell' is the diagnostic capsule shell. */
+export const DEBUG_MODES = Object.freeze(['off', 'skin-only', 'distance', 'weights', 'normals', 'candidates', 'shell']);
 
 /** Throws unless `mode` is one of DEBUG_MODES (every place a mode enters the runtime calls this). */
 export function checkDebugMode(mode) {

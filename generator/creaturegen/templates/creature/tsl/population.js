@@ -9,9 +9,11 @@ import { instancedArray } from 'three/tsl';
 import { CREATURE } from '../core/data.js';
 import { hashBytes } from '../core/hash.js';
 import { GENOME_LENGTH, drawGenome, genomeColours } from '../core/genome.js';
+import { LCG } from '../core/lcg.js';
 import { createDriver } from '../core/motion/driver.js';
 import { assertWaterFor, createMotion } from '../core/motion/motion.js';
 import { createFlatGround, createGravity } from '../core/motion/providers.js';
+import { POSE_ROWS } from '../core/pose.js';
 import { checkThreeRevision, loadSurface, resolveSurfaceUrl } from '../core/surface.js';
 import { defaultSurfaceUrl } from './asset.js';
 import { layoutOf } from './body.js';
@@ -49,7 +51,7 @@ export function surfaceGeometry(surface) {
   }
   geometry.setAttribute('cgSkin', new THREE.BufferAttribute(skin, 4));
   // The baked colours of the vertices that evaluate no field (a skin-represented tier); zeros elsewhere,
-  // where no vertex has CREATURE.skinProgram.
+  // where no vertex has SKIN_PROGRAM (body.js).
   geometry.setAttribute('cgColourSlots', new THREE.BufferAttribute(a._COLOUR_SLOTS?.array ?? new Float32Array(4 * n), 4));
   geometry.setAttribute('cgColourWeights', new THREE.BufferAttribute(a._COLOUR_WEIGHTS?.array ?? new Float32Array(4 * n), 4));
   geometry.setIndex(new THREE.BufferAttribute(surface.index.array, 1));
@@ -105,7 +107,7 @@ export async function createCreaturePopulation(renderer, options = {}) {
       + `maxStorageBufferBindingSize (${bindingLimit}); build a lighter tier`);
   }
   const pageSize = Math.min(requestedPageSize, capacity, fitting);
-  const floatsPerInstance = data.maxParts * data.poseRows * 4;
+  const floatsPerInstance = data.maxParts * POSE_ROWS * 4;
   const group = new THREE.Group();
   group.name = data.slug;
   const state = {
@@ -115,7 +117,7 @@ export async function createCreaturePopulation(renderer, options = {}) {
       uploads: 0, uploadBytes: 0, lastFrameBytes: 0, spawns: 0, ticks: 0, deformDispatches: 0, lastFrameDeformedVertices: 0,
     },
     pages: null,
-    rootRow: data.slotCount * data.poseRows * 4,
+    rootRow: data.slotCount * POSE_ROWS * 4,
     // Scratch for writing rows and bounds, reused by every body every frame.
     scratch: { tmp: new Float64Array(3), localBox: new Float64Array(6), corner: new THREE.Vector3(), box: new THREE.Box3() },
     tick: 0,
@@ -161,8 +163,8 @@ export async function createCreaturePopulation(renderer, options = {}) {
       for (const page of pages) {
         for (let j = 0; j < page.size; j++) {
           if (page.alive[j]) continue;
-          const genome = drawGenome(seed, data.lcg, page.genomes.subarray(GENOME_LENGTH * j, GENOME_LENGTH * (j + 1)));
-          page.motions[j] = createMotion(data.motion, data.lcg, { support, gravity, water, seed, position, genome });
+          const genome = drawGenome(seed, LCG, page.genomes.subarray(GENOME_LENGTH * j, GENOME_LENGTH * (j + 1)));
+          page.motions[j] = createMotion(data.motion, LCG, { support, gravity, water, seed, position, genome });
           genomeColours(data, genome, page.colours, 3 * data.slotCount * j);
           page.alive[j] = 1;
           page.seed[j] = seed;

@@ -1,0 +1,97 @@
+"""Constants of the runtime's own code live in the JS modules they describe, not in core/data.js.
+
+The pose and deform layouts, the candidate codes, the LCG and the debug views are the same for every
+creature and every build: each JS module exports its own (``export const NAME = value;``) and the Python
+side keeps its twin for the reference and the plan's workload figures. These tests read the modules'
+sources and pin every pair equal, show that a planted mismatch is caught, and check that CREATURE no longer
+echoes any of them.
+"""
+
+from __future__ import annotations
+
+import json
+import re
+
+import pytest
+
+from creaturegen.creature.plan import DEBUG_MODES, DEFORM_STRIDE
+from creaturegen.creature.pose import POSE_ROWS
+from creaturegen.creature.runtime import CreatureData
+from creaturegen.model.lcg import LCG_A, LCG_C
+from creaturegen.model.record import json_name
+from creaturegen.resources import templates_dir
+from creaturegen.surface.correction_region import NO_PROGRAM, SKIN_PROGRAM
+
+#: (module of the package, exported name, the Python value it must equal).
+PINNED: tuple[tuple[str, str, object], ...] = (
+    ("core/pose.js", "POSE_ROWS", POSE_ROWS),
+    ("core/lcg.js", "LCG_A", LCG_A),
+    ("core/lcg.js", "LCG_C", LCG_C),
+    ("tsl/deform.js", "DEFORM_STRIDE", DEFORM_STRIDE),
+    ("tsl/body.js", "NO_PROGRAM", NO_PROGRAM),
+    ("tsl/body.js", "SKIN_PROGRAM", SKIN_PROGRAM),
+    ("tsl/material.js", "DEBUG_MODES", list(DEBUG_MODES)),
+)
+
+#: CreatureData fields that were these constants: none may come back.
+MOVED = ("pose_rows", "lcg", "no_program", "skin_program", "debug_modes", "deform_stride")
+
+
+def js_constant(source: str, name: str) -> object:
+    """The value of ``export const NAME = value;`` in ``source``: an integer literal, or a frozen array of
+    string literals (``Object.freeze(['a', 'b'])``)."""
+    found = re.findall(rf"^export const {name} = (.+);$", source, re.M)
+    if len(found) != 1:
+        raise AssertionError(f"{name}: {len(found)} `export const {name} = …;` lines")
+    value = found[0]
+    if re.fullmatch(r"-?\d+", value):
+        return int(value)
+    frozen = re.fullmatch(r"Object\.freeze\((\[[^\]]*\])\)", value)
+    if frozen is None:
+        raise AssertionError(f"{name}: not an integer or a frozen array of strings: {value}")
+    return json.loads(frozen.group(1).replace("'", '"'))
+
+
+def mismatches(sources: dict[str, str]) -> list[str]:
+    """Every pinned constant whose JS value differs from its Python twin."""
+    return [
+        f"{path} {name} = {js_constant(sources[path], name)!r}, Python has {value!r}"
+        for path, name, value in PINNED
+        if js_constant(sources[path], name) != value
+    ]
+
+
+def _sources() -> dict[str, str]:
+    root = templates_dir("creature")
+    return {path: (root / path).read_text() for path, _, _ in PINNED}
+
+
+def test_every_runtime_constant_is_the_python_one() -> None:
+    assert mismatches(_sources()) == []
+
+
+@pytest.mark.parametrize(("path", "name", "value"), PINNED)
+def test_a_planted_mismatch_is_caught(path: str, name: str, value: object) -> None:
+    sources = _sources()
+    planted = "Object.freeze(['off'])" if isinstance(value, list) else str(int(str(value)) + 1)
+    line = re.compile(rf"^(export const {name} = ).+;$", re.M)
+    sources[path], count = line.subn(rf"\g<1>{planted};", sources[path])
+    assert count == 1
+    assert [m.split(" = ")[0] for m in mismatches(sources)] == [f"{path} {name}"]
+
+
+def test_a_missing_or_computed_constant_is_an_error() -> None:
+    with pytest.raises(AssertionError, match="0 `export const"):
+        js_constant("export const OTHER = 3;\n", "DEFORM_STRIDE")
+    with pytest.raises(AssertionError, match="not an integer"):
+        js_constant("export const DEFORM_STRIDE = CREATURE.deformStride;\n", "DEFORM_STRIDE")
+
+
+def test_creature_data_does_not_echo_the_runtime_constants() -> None:
+    fields = set(CreatureData.__dataclass_fields__)
+    assert not fields & set(MOVED)
+    for path in {p for p, _, _ in PINNED}:
+        source = (templates_dir("creature") / path).read_text()
+        for name in MOVED:
+            assert f"CREATURE.{json_name(name)}" not in source, (path, name)
+            assert f"data.{json_name(name)}" not in source, (path, name)
