@@ -9,8 +9,6 @@ export const CREATURE = Object.freeze({
     "earlyOut": 1e-07,
     "gradientFloor": 1e-08
   },
-  "debugModes": ["off", "skin-only", "distance", "weights", "normals", "candidates", "shell"],
-  "deformStride": 3,
   "fullProgram": 64,
   "genetics": {
     "chroma": 0.2,
@@ -19,10 +17,6 @@ export const CREATURE = Object.freeze({
   },
   "gradientFloor": 1e-12,
   "kFloor": 0.00124,
-  "lcg": {
-    "a": 1664525,
-    "c": 1013904223
-  },
   "maxParts": 8,
   "mesh": {
     "triangles": 12912,
@@ -117,8 +111,6 @@ export const CREATURE = Object.freeze({
     "wings": []
   },
   "name": "Hopper Squash Core",
-  "noProgram": 65535,
-  "poseRows": 5,
   "programCount": 65,
   "programData": [
     65.0, 3.0, 0.0, 0.0, 68.0, 5.0, 0.0, 0.0, 73.0, 9.0, 0.0, 0.0, 82.0, 9.0, 0.0, 0.0, 91.0, 3.0, 0.0, 0.0,
@@ -260,11 +252,10 @@ export const CREATURE = Object.freeze({
   "registers": 13,
   "roundCone": [0, 0, 0, 0, 0, 0, 0],
   "signatures": {
-    "compilerSignature": "c86fe5b78bff3c4ad9038e9f74b1785a34832f317fb90b36c3e211105d2cccd8",
+    "compilerSignature": "186d08a62934e056f7baf044e4b4343e20075712c9cabf94b86e8ef4e4297579",
     "geometryDigest": "400b0d18a2a9f6bbbfe5b441f89767f552a4f3b4c45a368d1129d632e1d2f4f1",
     "topologySignature": "330d551e8c006f84b01459c84db69ca8c43aec5bc9d9083d3e85c291be5a68bf"
   },
-  "skinProgram": 65534,
   "slotCount": 7,
   "slotLab": [
     [0.6533914592712566, -0.0015519578906336706, -0.06706245035577174],

@@ -17,12 +17,6 @@ export interface CreatureSignatures {
 }
 
 // The interfaces of CREATURE (core/data.js), rendered from the records creaturegen builds it as.
-/** The LCG every instance stream uses: state' = (a·state + c) mod 2^32. */
-export interface Lcg {
-  readonly a: number;
-  readonly c: number;
-}
-
 /**
  * The bounds of the colour genes, as the runtime reads them (CREATURE.genetics): each gene in [-1, 1) times
  * its bound.
@@ -227,12 +221,10 @@ export interface CreatureData {
   readonly slotCount: number;
   /** Pose-texture parts per instance: every slot, and one for the root rows. */
   readonly maxParts: number;
-  readonly poseRows: number;
   /** Rest slot table, one row of 12 numbers per slot. */
   readonly slots: readonly (readonly number[])[];
   readonly slotNames: readonly string[];
   readonly roundCone: readonly number[];
-  readonly lcg: Lcg;
   readonly genetics: ColourGenetics;
   /** OKLab coordinates of every slot's authored colour, which the colour genes mutate. */
   readonly slotLab: readonly Vec3[];
@@ -241,12 +233,6 @@ export interface CreatureData {
   readonly programData: readonly number[];
   readonly programCount: number;
   readonly fullProgram: number;
-  readonly noProgram: number;
-  /**
-   * The candidate code of a vertex that evaluates no field (a skin-represented tier): skinned position and
-   * normal, baked colour.
-   */
-  readonly skinProgram: number;
   readonly registers: number;
   readonly candidateNote: string;
   readonly gradientFloor: number;
@@ -254,17 +240,27 @@ export interface CreatureData {
   readonly kFloor: number;
   readonly correction: CorrectionData;
   readonly mesh: MeshCounts;
-  readonly debugModes: readonly DebugMode[];
-  readonly deformStride: number;
 }
 
 export const CREATURE: CreatureData;
+/** The LCG every instance stream uses: state' = (a·state + c) mod 2^32. */
+export interface Lcg {
+  readonly a: number;
+  readonly c: number;
+}
+/** Numerical Recipes' multiplier and increment, modulo 2^32 (the Python reference's, model/lcg.py). */
+export const LCG_A: number;
+export const LCG_C: number;
+/** `{ a: LCG_A, c: LCG_C }`: what drawGenome, instanceYaw and createMotion take. */
+export const LCG: Lcg;
 export function lcgNext(state: number, a: number, c: number): number;
 /** The first state of an instance's LCG stream (murmur3's 32-bit finaliser of the seed). */
 export function mixSeed(seed: number): number;
 export function instanceYaw(seed: number, lcg: Lcg): number;
 /** R(q)·v with q at q[qo..qo+3] (xyzw) and v at v[vo..vo+2]; vectors travel as (array, offset) so no call boxes a double. */
 export function rotate(q: ArrayLike<number>, qo: number, v: ArrayLike<number>, vo: number, out: Vec, o: number): void;
+/** vec4 rows per slot in a pose page: (a, ra), (b, rb), (k, rgb), quaternion xyzw, (t, roundCone). */
+export const POSE_ROWS: number;
 /** An instance's slot rows; `size` (the motion's) scales the rest ends, radii and blend widths. */
 export function writePoseRows(data: CreatureData, quats: ArrayLike<number>, trans: ArrayLike<number>, colours: ArrayLike<number> | null, co: number, tmp: Float64Array, target: Float32Array, base: number, bounds: Float64Array, size?: number): void;
 /** Floats in a genome: hue, chroma, lightness, the gait genes, then size (each signed, in [-1, 1)). */
