@@ -53,3 +53,16 @@ def test_exported_schema_rejects_what_the_gate_rejects(name: str) -> None:
     """Editors using the schema see per-shape and per-type rules too, not only field types."""
     data = json.loads((INVALID / f"{name}.json").read_text())
     assert list(_validator(SCHEMAS / "character-spec.schema.json").iter_errors(data)) != []
+
+
+def test_the_colour_schema_is_defined_once_and_referenced_by_every_part_shape() -> None:
+    """Every part shape has a colour; its schema (the CSS names as an enum and as an any-case pattern)
+    lives in $defs once."""
+    schema = json.loads(render_schemas()["character-spec.schema.json"])
+    text = json.dumps(schema)
+    assert text.count('"aliceblue"') == 1
+    shapes = [name for name in schema["$defs"] if name.endswith("Part")]
+    assert len(shapes) == 5
+    for name in shapes:
+        colour = schema["$defs"][name]["properties"]["color"]
+        assert {"$ref": "#/$defs/Color"} in colour["anyOf"], name

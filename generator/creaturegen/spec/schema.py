@@ -10,6 +10,7 @@ from pathlib import Path
 from typing import Any
 
 from .character import CharacterSpec
+from .colors import COLOR_JSON_SCHEMA
 from .frost import FrostEffectSpec
 
 SCHEMA_FILES: dict[str, type[CharacterSpec] | type[FrostEffectSpec]] = {
@@ -18,8 +19,29 @@ SCHEMA_FILES: dict[str, type[CharacterSpec] | type[FrostEffectSpec]] = {
 }
 
 
+#: Where the colour's schema lives once: every part shape has a ``color``, and pydantic inlines an
+#: annotated type at each use (the CSS names as an enum and as an any-case pattern, in each part shape).
+COLOR_REF = "#/$defs/Color"
+
+
+def _shared_colour(node: Any) -> tuple[Any, bool]:
+    """``node`` with every inlined colour schema replaced by a reference to ``$defs/Color``; and whether
+    any was."""
+    if node == COLOR_JSON_SCHEMA:
+        return {"$ref": COLOR_REF}, True
+    if isinstance(node, dict):
+        pairs = [(key, _shared_colour(value)) for key, value in node.items()]
+        return {key: value for key, (value, _) in pairs}, any(found for _, (_, found) in pairs)
+    if isinstance(node, list):
+        items = [_shared_colour(value) for value in node]
+        return [value for value, _ in items], any(found for _, found in items)
+    return node, False
+
+
 def schema_of(model: type[CharacterSpec] | type[FrostEffectSpec], filename: str) -> dict[str, Any]:
-    schema = model.model_json_schema(by_alias=True, mode="validation")
+    schema, shared = _shared_colour(model.model_json_schema(by_alias=True, mode="validation"))
+    if shared:
+        schema.setdefault("$defs", {})["Color"] = COLOR_JSON_SCHEMA
     return {"$schema": "https://json-schema.org/draft/2020-12/schema", "$id": filename, **schema}
 
 
