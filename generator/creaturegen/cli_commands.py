@@ -7,7 +7,9 @@ from __future__ import annotations
 import argparse
 import json
 import sys
+from collections.abc import Callable
 from pathlib import Path
+from typing import TypeVar
 
 import numpy as np
 
@@ -17,11 +19,14 @@ from .cli_errors import EXIT_GATE_FAILED, EXIT_INVALID, EXIT_OK, print_errors
 from .cli_report import print_gates
 from .field.sampler import sample
 from .motion.compiled import compile_creature
-from .rig import CompiledRig, RigCompileError, compile_rig
+from .rig import RigCompileError, compile_rig
 from .rig.report import describe_rig
 from .spec import CharacterSpec, SpecError, SpecValidationError, load_spec
 from .spec.schema import stale_schemas, write_schemas
 from .spec.summary import summarize
+
+#: What a command compiles a spec to: the rig alone (probe) or the whole compiled creature (inspect).
+T = TypeVar("T")
 
 
 def validate_command(args: argparse.Namespace) -> int:
@@ -55,14 +60,15 @@ def schema_command(args: argparse.Namespace) -> int:
     return EXIT_OK
 
 
-def _compiled(name: str) -> tuple[CharacterSpec, CompiledRig] | None:
-    """Validate and compile a creature spec, printing every error when that fails."""
+def _compiled(name: str, compile_spec: Callable[[CharacterSpec], T]) -> T | None:
+    """Validate a creature spec and compile it with ``compile_spec`` (the rig alone, or the whole
+    compiled creature), printing every error when either fails."""
     try:
         spec = load_spec(Path(name))
         if not isinstance(spec, CharacterSpec):
             print_errors(name, [SpecError("kind", "must be creature for this command")])
             return None
-        return spec, compile_rig(spec)
+        return compile_spec(spec)
     except (SpecValidationError, RigCompileError) as exc:
         print_errors(name, exc.errors)
         return None
@@ -81,10 +87,9 @@ def read_points(path: Path) -> np.ndarray:
 
 
 def probe_command(args: argparse.Namespace) -> int:
-    compiled = _compiled(args.spec)
-    if compiled is None:
+    rig = _compiled(args.spec, compile_rig)
+    if rig is None:
         return EXIT_INVALID
-    rig = compiled[1]
     try:
         points = read_points(Path(args.points))
     except ValueError as exc:
@@ -105,10 +110,10 @@ def probe_command(args: argparse.Namespace) -> int:
 
 
 def inspect_command(args: argparse.Namespace) -> int:
-    compiled = _compiled(args.spec)
-    if compiled is None:
+    creature = _compiled(args.spec, compile_creature)
+    if creature is None:
         return EXIT_INVALID
-    spec, rig = compiled
+    rig = creature.rig
     report = describe_rig(rig)
     tiers = tuple(t for t in args.tiers.split(",") if t)
     unknown = [t for t in tiers if t not in TIERS]
@@ -116,7 +121,6 @@ def inspect_command(args: argparse.Namespace) -> int:
         print(f"--tiers: unknown tier {unknown[0]!r} (known: {', '.join(TIERS)})", file=sys.stderr)
         return EXIT_INVALID
     print(f"==> candidate programs for tiers {', '.join(tiers)}", file=sys.stderr)
-    creature = compile_creature(spec)
     report["candidates"] = describe_candidates(creature, tiers)
     surface = None
     if args.surface:

@@ -372,6 +372,7 @@ def _asset(
     mesh, colour, programs = ex.mesh, correction.colour, correction.programs
     frames = rest_frames(rig, skeleton)
     radial = _radial(rig, mesh.vertices, weights.indices[:, 0], frames)
+    methods = vertex_methods(weights.indices, weights.weights, choice.methods, skeleton)
     return SurfaceAsset(
         positions=mesh.vertices.astype(np.float32),
         normals=ex.normals.astype(np.float32),
@@ -381,14 +382,8 @@ def _asset(
         candidate=programs.astype(np.uint16),
         radial=radial.astype(np.float32),
         rest_frames=np.transpose(frames, (0, 2, 1)).astype(np.float32),
-        skin=runtime_skin(
-            weights.indices, weights.weights, choice, skeleton, correction.region, programs, correction.trust
-        ),
-        cor_centers=np.where(
-            (vertex_methods(weights.indices, weights.weights, choice.methods, skeleton) == 2)[:, None],
-            choice.centers,
-            0.0,
-        ).astype(np.float32),
+        skin=runtime_skin(methods, correction.radius),
+        cor_centers=np.where((methods == 2)[:, None], choice.centers, 0.0).astype(np.float32),
         extras={"creaturegen": __version__, "tier": tier, **signatures},
         colour_slots=None if colour is None else colour.slots,
         colour_weights=None if colour is None else colour.weights,

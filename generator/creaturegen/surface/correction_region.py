@@ -41,7 +41,7 @@ from .skin_tier import (
     skin_contract,
     skin_departures,
 )
-from .skinning import Skinned, skin, vertex_methods
+from .skinning import Skinned, skin
 from .sweep import sweep_poses
 from .weights import SkinWeights
 
@@ -200,23 +200,11 @@ def never_worse(report: CorrectionReport) -> SurfaceGate:
     )
 
 
-def runtime_skin(
-    indices: npt.NDArray[np.int32],
-    weights: F64,
-    choice: DeformationChoice,
-    skeleton: Skeleton,
-    region: npt.NDArray[np.bool_],
-    programs: npt.NDArray[np.int64],
-    trust: F64,
-) -> npt.NDArray[np.float32]:
-    """(V, 2) what the runtime needs per vertex: its skinning method code and its correction trust radius.
-
-    The trust radius is zero outside the region policy's vertices (and where no candidate program covers
-    a vertex), so the runtime corrects exactly the vertices the build proved need it.
-    """
-    method = vertex_methods(indices, weights, choice.methods, skeleton).astype(np.float64)
-    radius = np.where(region & (programs != NO_PROGRAM), trust, 0.0)
-    return np.stack([method, radius], axis=1).astype(np.float32)
+def runtime_skin(methods: npt.NDArray[np.integer], radius: F64) -> npt.NDArray[np.float32]:
+    """(V, 2) what the runtime needs per vertex: its skinning method code and its correction trust radius
+    (``CorrectionStage.radius``: zero outside the region policy's vertices and where no candidate program
+    covers a vertex, so the runtime corrects exactly the vertices the build proved need it)."""
+    return np.stack([methods.astype(np.float64), radius], axis=1).astype(np.float32)
 
 
 def candidate_index(found: CandidateSet | str, rest: F64) -> tuple[npt.NDArray[np.int64], str]:

@@ -252,7 +252,7 @@ export const CREATURE = Object.freeze({
   "registers": 13,
   "roundCone": [0, 0, 0, 0, 0, 0, 0],
   "signatures": {
-    "compilerSignature": "186d08a62934e056f7baf044e4b4343e20075712c9cabf94b86e8ef4e4297579",
+    "compilerSignature": "9e2c2dad5a2211fd4835a5f5fddef3b635c38436ba08dd471c101aa24365578d",
     "geometryDigest": "400b0d18a2a9f6bbbfe5b441f89767f552a4f3b4c45a368d1129d632e1d2f4f1",
     "topologySignature": "330d551e8c006f84b01459c84db69ca8c43aec5bc9d9083d3e85c291be5a68bf"
   },
