@@ -11,6 +11,7 @@ which runs in headless Chromium (browser marker). The strict TypeScript check in
 from __future__ import annotations
 
 import base64
+import hashlib
 import json
 import re
 import shutil
@@ -32,14 +33,17 @@ from creaturegen.creature.assets import (
     surface_file,
     surface_path,
 )
+from creaturegen.creature.plan import program_data, program_tapes
 from creaturegen.emit.lint import lint_sources
 from creaturegen.model.skeleton import build_skeleton
+from creaturegen.motion.compiled import compile_creature
 from creaturegen.motion.rig import build_motion
 from creaturegen.resources import lab_modules
 from creaturegen.rig import compile_rig
 from creaturegen.rig.signatures import signatures
 from creaturegen.spec import CharacterSpec, load_spec, slugify, validate_bytes
 from creaturegen.spec.character import LocomotionType
+from creaturegen.surface.glb import parse_program, program_digest
 from test_runtime_constants import js_constant
 
 HOPPER = "reference/hopper.json"
@@ -131,11 +135,18 @@ def tampered_glb(glb: bytes, digest: str) -> tuple[bytes, str]:
 # --- 1. asset names and URLs ---------------------------------------------------------------------------
 
 
-def test_surface_asset_is_named_by_package_and_geometry(hopper: Path) -> None:
+def test_surface_asset_is_named_by_package_geometry_and_programs(hopper: Path) -> None:
     report = package_report(hopper)
     digest = report["signatures"]["geometryDigest"]
-    name = f"{hopper.name}-{digest[:12]}.glb"
-    assert surface_file(hopper.name, digest) == name
+    glb = next((hopper / "assets").glob("*.glb")).read_bytes()
+    program = parse_program(glb)
+    assert program is not None
+    programs = program_digest(program)
+    both = hashlib.sha256(f"{digest}:{programs}".encode()).hexdigest()
+    name = f"{hopper.name}-{both[:12]}.glb"
+    assert surface_file(hopper.name, digest, programs) == name
+    # Another tier's programs over the same mesh get another name.
+    assert surface_file(hopper.name, digest, "0" * 64) != name
     assert report["assets"] == {"surface": f"assets/{name}", "spec": SPEC_PATH, "sidecar": SIDECAR_PATH}
     assert surface_path(hopper) == hopper / "assets" / name
     assert [p.name for p in (hopper / "assets").glob("*.glb")] == [name]
@@ -320,6 +331,50 @@ def test_glb_without_signatures_is_refused(hopper: Path, tmp_path: Path) -> None
     assert error["name"] == "SurfaceMismatchError"
     assert error["found"] == dict.fromkeys(error["expected"])
     assert "geometryDigest (none)" in error["message"]
+
+
+def test_surface_with_other_programs_is_refused(hopper: Path, tmp_path: Path) -> None:
+    """The program tapes ride in the .glb: a file whose programs are another build's (another
+    programDigest, as another tier of the same mesh has), or that carries none (the surface cache's
+    .glb), is refused with SurfaceMismatchError naming programDigest; the tapes it carries are the ones
+    the Python reference compiles (creature/plan.py program_data)."""
+    glb = surface_path(hopper).read_bytes()
+    program = parse_program(glb)
+    assert program is not None
+    programs = program_digest(program)
+    report = package_report(hopper)
+    creature = compile_creature(load_spec(hopper / SPEC_PATH))
+    tapes, _ = program_tapes(creature, report["tier"])
+    assert program.tolist() == np.asarray(program_data(tapes), dtype=np.float32).tolist()
+    other_tier, _ = tampered_glb(glb, programs)
+    length = int.from_bytes(glb[12:16], "little")
+    document = json.loads(glb[20 : 20 + length])
+    document["nodes"][0]["extras"].pop("programAccessor")
+    text = json.dumps(document, separators=(",", ":")).encode()
+    bare = glb[:20] + text + b" " * (length - len(text)) + glb[20 + length :]
+    assert parse_program(bare) is None
+    files = {"otherTier": other_tier, "bare": bare}
+    for name, data in files.items():
+        (tmp_path / f"{name}.glb").write_bytes(data)
+    script = (
+        "import { SurfaceMismatchError, ThreeRevisionError, loadSurface }"
+        f" from {json.dumps((hopper / 'core' / 'index.js').as_uri())};"
+        + FILE_FETCH
+        + "const out = {};"
+        + "".join(
+            f"out.{name} = await caught(loadSurface({json.dumps((tmp_path / f'{name}.glb').as_uri())}));"
+            for name in files
+        )
+        + "console.log(JSON.stringify(out));"
+    )
+    out = run_js(hopper, script)
+    for name in files:
+        error = out[name]
+        assert error is not None, name
+        assert error["name"] == "SurfaceMismatchError", (name, error)
+        assert error["expected"]["programDigest"] == programs
+        assert error["found"]["programDigest"] != programs
+        assert "programDigest" in error["message"], error["message"]
 
 
 # --- 3. three's revision and the types -------------------------------------------------------------------

@@ -1,14 +1,17 @@
 """The files of a creature package beside its code: where each one lives and what exactly ships.
 
-The surface asset is named ``assets/<slug>-<geometryDigest[:12]>.glb`` because consumers merge assets:
-a bundler or a copy step that puts every package's ``assets/`` into one folder of a site must never let
-one creature's mesh stand in for another's (two packages that both shipped ``assets/surface.glb`` did
-exactly that: the quadruped silently drew the hopper's body). Python tools find the file through
+The surface asset is named ``assets/<slug>-<digest[:12]>.glb``, the digest of its geometry and of the
+program tapes it carries (surface/glb.py), because consumers merge assets: a bundler or a copy step
+that puts every package's ``assets/`` into one folder of a site must never let one creature's mesh or
+programs stand in for another's (two packages that both shipped ``assets/surface.glb`` did exactly
+that: the quadruped silently drew the hopper's body; two tiers of one body share a mesh, not their
+programs). Python tools find the file through
 :func:`surface_path`, never by spelling the name, so the rule has one definition here.
 """
 
 from __future__ import annotations
 
+import hashlib
 import json
 from pathlib import Path
 from typing import Any
@@ -23,22 +26,25 @@ SIDECAR_PATH = f"{ASSET_DIR}/surface.json"
 REPORT_PATH = "build-report.json"
 #: The README picture (rendered by the lab, lab/picture.py), shipped when the build made one.
 PICTURE_PATH = f"{ASSET_DIR}/preview.png"
-#: Hex digits of the geometryDigest in the asset's name: 48 bits, unique across any realistic site.
+#: Hex digits of the asset digest in the file's name: 48 bits, unique across any realistic site.
 DIGEST_DIGITS = 12
 
 
-def surface_file(slug: str, geometry_digest: str) -> str:
-    """The .glb's file name: the package slug and its geometry, so merged asset folders never collide."""
-    if len(geometry_digest) < DIGEST_DIGITS or not all(c in "0123456789abcdef" for c in geometry_digest):
-        raise ValueError(f"geometryDigest: expected lowercase hex, got {geometry_digest!r}")
-    return f"{slug}-{geometry_digest[:DIGEST_DIGITS]}.glb"
+def surface_file(slug: str, geometry_digest: str, program_digest: str) -> str:
+    """The .glb's file name: the package slug, its geometry and its programs, so merged asset folders
+    never collide."""
+    for key, digest in (("geometryDigest", geometry_digest), ("programDigest", program_digest)):
+        if len(digest) < DIGEST_DIGITS or not all(c in "0123456789abcdef" for c in digest):
+            raise ValueError(f"{key}: expected lowercase hex, got {digest!r}")
+    both = hashlib.sha256(f"{geometry_digest}:{program_digest}".encode("ascii")).hexdigest()
+    return f"{slug}-{both[:DIGEST_DIGITS]}.glb"
 
 
-def asset_plan(slug: str, geometry_digest: str) -> dict[str, str]:
+def asset_plan(slug: str, geometry_digest: str, program_digest: str) -> dict[str, str]:
     """What templates print about the assets: the file name, its path in the package, and the URL
     relative to a module one folder below the root (tsl/, core/), as the one static literal of the
     ``new URL(..., import.meta.url)`` expression that asset-aware bundlers look for."""
-    name = surface_file(slug, geometry_digest)
+    name = surface_file(slug, geometry_digest, program_digest)
     return {"surfaceFile": name, "surfacePath": f"{ASSET_DIR}/{name}", "surfaceUrl": f"../{ASSET_DIR}/{name}"}
 
 

@@ -57,7 +57,7 @@ def creature_files(
     files = render_folder("creature", plan, spec_sha256)
     # The spec (minus an unresolvable $schema): the parity job rebuilds the Python reference from it.
     files.append(PackageFile(SPEC_PATH, shipped_spec(spec_bytes)))
-    glb = glb_bytes(surface.asset, name=str(plan["slug"]))
+    glb = glb_bytes(surface.asset, name=str(plan["slug"]), program=built.program)
     files.append(PackageFile(str(plan["assets"]["surfacePath"]), glb))
     sidecar = {"//": header_text(spec_sha256), **stable_sidecar(surface.sidecar)}
     files.append(PackageFile(SIDECAR_PATH, sidecar_bytes(sidecar)))

@@ -28,6 +28,7 @@ from ..spec.character import LocomotionType
 from ..surface import correct as correction
 from ..surface.build import SurfaceBuild
 from ..surface.correction_region import NO_PROGRAM, SKIN_PROGRAM
+from ..surface.glb import program_digest
 from ..surface.skinning import METHODS
 from .assets import asset_plan
 from .pose import POSE_ROWS
@@ -51,6 +52,7 @@ class CreaturePlan:
     runtime: CreatureData
     tapes: tuple[Tape, ...]  # candidate programs in asset order, then the full graph
     skeleton: Skeleton
+    program: tuple[float, ...]  # the tapes flat, as the .glb carries them (program_data)
 
 
 def program_tapes(
@@ -106,8 +108,10 @@ def build_plan(creature: CompiledCreature, surface: SurfaceBuild, spec_sha256: s
     spec, rig, skeleton, motion = creature.spec, creature.rig, creature.skeleton, creature.motion
     tapes, note = program_tapes(creature, surface.tier, surface.candidates)
     slug = slugify(spec.name)
-    assets = asset_plan(slug, surface.signatures["geometryDigest"])
-    runtime = _runtime(spec, rig, surface, spec_sha256, skeleton, motion, tapes, note, slug, assets)
+    program = program_data(tapes)
+    assets = asset_plan(slug, surface.signatures["geometryDigest"], program_digest(program))
+    programs = (tapes, program)
+    runtime = _runtime(spec, rig, surface, spec_sha256, skeleton, motion, programs, note, slug, assets)
     workload = _workload(rig, surface, runtime, tapes)
     runtime_json = runtime.to_json()
     skin = np.asarray(surface.asset.skin)  # (V, 2): method code, trust radius
@@ -138,7 +142,7 @@ def build_plan(creature: CompiledCreature, surface: SurfaceBuild, spec_sha256: s
             "declarations": data_declarations(),
         },
     }
-    return CreaturePlan(plan, runtime, tuple(tapes), skeleton)
+    return CreaturePlan(plan, runtime, tuple(tapes), skeleton, tuple(program))
 
 
 def _runtime(
@@ -148,12 +152,13 @@ def _runtime(
     spec_sha256: str,
     skeleton: Skeleton,
     motion: MotionData,
-    tapes: list[Tape],
+    programs: tuple[list[Tape], list[float]],
     note: str,
     slug: str,
     assets: dict[str, Any],
 ) -> CreatureData:
-    """``plan["runtime"]``: the data core/data.js holds."""
+    """``plan["runtime"]``: the data core/data.js holds; ``programs`` are the tapes and their flat data."""
+    tapes, program = programs
     floors = floors_for(rig.body_scale)
     asset = surface.asset
     return CreatureData(
@@ -178,7 +183,9 @@ def _runtime(
         slot_lab=tuple((big_l, a, b) for big_l, a, b in slot_lab(rig.slots[:, col.RGB])),
         motion=motion,
         tick_rate=motion.hz,
-        program_data=tuple(program_data(tapes)),
+        # The tapes themselves ride in the .glb (surface/glb.py): a GPU buffer, not data to read.
+        program_digest=program_digest(program),
+        program_rows=len(program) // 4,
         program_count=len(tapes),
         full_program=len(tapes) - 1,
         registers=max(len(t) for t in tapes),

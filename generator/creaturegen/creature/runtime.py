@@ -71,7 +71,10 @@ class CreatureData(JsonRecord):
     """OKLab coordinates of every slot's authored colour, which the colour genes mutate."""
     motion: MotionData
     tick_rate: int
-    program_data: tuple[float, ...]
+    program_digest: str
+    """sha256 of the program tapes the .glb carries (surface/glb.py ``program_digest``), checked on load."""
+    program_rows: int
+    """Their length in vec4 rows: a header per program, then every instruction."""
     program_count: int
     full_program: int
     registers: int

@@ -23,7 +23,11 @@ underscore; three.js's GLTFLoader lower-cases unknown names, so ``_SLOTS`` arriv
 
 Indices are UNSIGNED_SHORT when every index fits below 65535 (the value glTF reserves for primitive
 restart), UNSIGNED_INT otherwise. Per-slot rest frames are one more accessor (FLOAT MAT4, count S)
-that no primitive uses; the node's ``extras.restFramesAccessor`` names it. The caller's ``extras``
+that no primitive uses; the node's ``extras.restFramesAccessor`` names it. A package's .glb carries one
+more: the candidate program tapes (FLOAT VEC4, surface/glb.py ``PROGRAM_KEY``: headers then instructions,
+creature/plan.py ``program_data``), the GPU buffer the runtime's field reads, named by the node's
+``extras.programAccessor``; its digest (``programDigest``, the sha256 of its little-endian float32
+bytes) joins the signatures in ``asset.extras``. The caller's ``extras``
 (signatures and such) go to both ``asset.extras`` and the node's ``extras``: three.js exposes the
 first as ``gltf.asset.extras`` and the second as the mesh's ``userData``.
 
@@ -39,6 +43,7 @@ the BIN chunk with zeros.
 
 from __future__ import annotations
 
+import hashlib
 import json
 import os
 import struct
@@ -70,6 +75,24 @@ MAX_UINT16_VERTICES: Final = 65535
 
 _COMPONENT_DTYPES: Final[dict[int, str]] = {UNSIGNED_SHORT: "<u2", UNSIGNED_INT: "<u4", FLOAT: "<f4"}
 _TYPE_SIZES: Final[dict[str, int]] = {"SCALAR": 1, "VEC2": 2, "VEC3": 3, "VEC4": 4, "MAT4": 16}
+
+
+#: The node extra naming the program tapes' accessor, and the asset extra holding their digest.
+PROGRAM_KEY: Final = "programAccessor"
+PROGRAM_DIGEST_KEY: Final = "programDigest"
+
+
+def program_bytes(program: npt.ArrayLike) -> bytes:
+    """The program tapes as the .glb stores them: float32, little-endian, four numbers per row."""
+    values = np.ascontiguousarray(program, dtype="<f4")
+    if values.ndim != 1 or values.size == 0 or values.size % 4:
+        raise ValueError(f"program tapes: expected a flat, non-empty array of vec4 rows, got {values.shape}")
+    return values.tobytes()
+
+
+def program_digest(program: npt.ArrayLike) -> str:
+    """sha256 of :func:`program_bytes`: the signature core/surface.js compares before drawing."""
+    return hashlib.sha256(program_bytes(program)).hexdigest()
 
 
 class GlbFormatError(ValueError):
@@ -130,8 +153,10 @@ class _BinBuilder:
         return len(self.accessors) - 1
 
 
-def glb_bytes(asset: SurfaceAsset, *, name: str) -> bytes:
-    """The .glb file of ``asset`` as bytes (a pure function of its arguments)."""
+def glb_bytes(asset: SurfaceAsset, *, name: str, program: npt.ArrayLike | None = None) -> bytes:
+    """The .glb file of ``asset`` as bytes (a pure function of its arguments); with ``program`` (a
+    package's program tapes, flat) the tapes ride in the same file, so the runtime fetches one asset and
+    a copy step cannot pair a mesh with another build's programs."""
     b = _BinBuilder()
     attributes = {
         "POSITION": b.add(asset.positions, FLOAT, "VEC3", target=ARRAY_BUFFER, minmax=True),
@@ -151,14 +176,21 @@ def glb_bytes(asset: SurfaceAsset, *, name: str) -> bytes:
     index_type = UNSIGNED_SHORT if asset.vertex_count <= MAX_UINT16_VERTICES else UNSIGNED_INT
     indices = b.add(asset.indices, index_type, "SCALAR", target=ELEMENT_ARRAY_BUFFER)
     rest_frames = b.add(asset.rest_frames.reshape(-1, 16), FLOAT, "MAT4", target=None)
+    extras: dict[str, object] = dict(asset.extras)
+    node_extras: dict[str, object] = {**asset.extras, REST_FRAMES_KEY: rest_frames}
+    if program is not None:
+        rows = np.frombuffer(program_bytes(program), dtype="<f4").reshape(-1, 4)
+        extras[PROGRAM_DIGEST_KEY] = program_digest(program)
+        node_extras = {**extras, REST_FRAMES_KEY: rest_frames}
+        node_extras[PROGRAM_KEY] = b.add(rows, FLOAT, "VEC4", target=None)
 
     document: dict[str, object] = {
-        "asset": {"version": "2.0", "generator": f"creaturegen {__version__}", "extras": asset.extras},
+        "asset": {"version": "2.0", "generator": f"creaturegen {__version__}", "extras": extras},
         "scene": 0,
         # The scene stays unnamed: three.js reserves names scene-first, so a named scene would turn
         # the mesh object's name into `<name>_1`.
         "scenes": [{"nodes": [0]}],
-        "nodes": [{"name": name, "mesh": 0, "extras": {**asset.extras, REST_FRAMES_KEY: rest_frames}}],
+        "nodes": [{"name": name, "mesh": 0, "extras": node_extras}],
         "meshes": [
             {
                 "name": name,
@@ -276,6 +308,7 @@ def parse_glb(data: bytes) -> SurfaceAsset:
         attributes = primitive["attributes"]
         node_extras = dict(node.get("extras", {}))
         rest_index = node_extras.pop(REST_FRAMES_KEY)
+        node_extras.pop(PROGRAM_KEY, None)
         indices = _read_accessor(document, binary, primitive["indices"], "SCALAR")
         return SurfaceAsset(
             positions=_read_accessor(document, binary, attributes["POSITION"], "VEC3"),
@@ -304,6 +337,23 @@ def parse_glb(data: bytes) -> SurfaceAsset:
         raise
     except (KeyError, IndexError, TypeError, ValueError, AttributeError, struct.error) as error:
         raise GlbFormatError(f"not a creaturegen surface: {type(error).__name__}: {error}") from error
+
+
+def parse_program(data: bytes) -> npt.NDArray[np.float32] | None:
+    """The program tapes a package's .glb carries (flat, as creature/plan.py ``program_data`` wrote
+    them), or None for a .glb without them (the surface cache's)."""
+    try:
+        document, binary = _parse_chunks(data)
+        node = document["nodes"][document["scenes"][document.get("scene", 0)]["nodes"][0]]
+        index = node.get("extras", {}).get(PROGRAM_KEY)
+        if index is None:
+            return None
+        rows: npt.NDArray[np.float32] = _read_accessor(document, binary, index, "VEC4").reshape(-1)
+        return rows
+    except GlbFormatError:
+        raise
+    except (KeyError, IndexError, TypeError, ValueError, AttributeError, struct.error) as error:
+        raise GlbFormatError(f"not a creaturegen package surface: {type(error).__name__}: {error}") from error
 
 
 def read_glb(path: Path) -> SurfaceAsset:

@@ -26,5 +26,9 @@ export function parseGlb(buffer, source = 'surface') {
   const primitive = doc.meshes[node.mesh].primitives[0];
   const attributes = {};
   for (const [name, index] of Object.entries(primitive.attributes)) attributes[name] = read(index);
-  return { attributes, index: read(primitive.indices), extras: doc.asset.extras || {} };
+  // The candidate program tapes (vec4 rows: a header per program, then the instructions) travel in the
+  // same file as the mesh they were compiled for; the node's extras name their accessor.
+  const programIndex = node.extras?.programAccessor;
+  const program = Number.isInteger(programIndex) ? read(programIndex).array : null;
+  return { attributes, index: read(primitive.indices), program, extras: doc.asset.extras || {} };
 }

@@ -4,8 +4,11 @@
 import { CREATURE } from './data.js';
 import { parseGlb } from './glb.js';
 
-/** The signatures a .glb must carry to be this package's surface (surface/asset.py writes them). */
-export const SURFACE_KEYS = Object.freeze(['geometryDigest', 'topologySignature', 'compilerSignature', 'tier']);
+/**
+ * The signatures a .glb must carry to be this package's surface (surface/asset.py writes them;
+ * programDigest is the sha256 of the program tapes the file carries, surface/glb.py).
+ */
+export const SURFACE_KEYS = Object.freeze(['geometryDigest', 'topologySignature', 'compilerSignature', 'tier', 'programDigest']);
 
 /**
  * The fetched .glb is not this package's surface (another package's file under a shared name, a stale
@@ -46,7 +49,7 @@ export function checkThreeRevision(revision) {
 
 /** The signatures this package expects of its surface: its own plan's. */
 export function expectedSurface() {
-  return { ...CREATURE.signatures, tier: CREATURE.tier };
+  return { ...CREATURE.signatures, tier: CREATURE.tier, programDigest: CREATURE.programDigest };
 }
 
 /** Throws SurfaceMismatchError unless the .glb's asset.extras carry this package's signatures. */
@@ -92,5 +95,8 @@ export async function loadSurface(url) {
   }
   const surface = parseGlb(await response.arrayBuffer(), url);
   checkSurface(surface.extras, url);
+  if (surface.program?.length !== 4 * CREATURE.programRows) {
+    throw new SurfaceMismatchError(CREATURE.slug, String(url), expectedSurface(), { ...surface.extras, programDigest: null });
+  }
   return surface;
 }

@@ -91,8 +91,8 @@ export function createShellMesh(layout: Layout, pose: PoseStorage, name: string)
 
 /** Throws unless `renderer` is an initialised WebGPURenderer on the WebGPU backend. */
 export function assertWebGPU(renderer: WebGPURenderer): void;
-/** The program tapes as one read-only vec4 storage node. */
-export function programStorage(data: CreatureData): PoseStorage;
+/** The program tapes a loaded surface carries, as one read-only vec4 storage node. */
+export function programStorage(surface: ParsedSurface): PoseStorage;
 /** BufferGeometry of the parsed reference surface with the skinning attributes the material reads. */
 export function surfaceGeometry(surface: ParsedSurface): BufferGeometry;
 /** The .glb's file name in assets/ (CREATURE.surfaceFile). */

@@ -58,9 +58,9 @@ export function surfaceGeometry(surface) {
   return geometry;
 }
 
-/** The program tape as a vec4 storage node (headers, then instructions), shared by every page. */
-export function programStorage(data) {
-  return instancedArray(new Float32Array(data.programData), 'vec4').toReadOnly();
+/** The program tapes the .glb carries as a vec4 storage node (headers, then instructions), shared by every page. */
+export function programStorage(surface) {
+  return instancedArray(surface.program, 'vec4').toReadOnly();
 }
 
 /** Throws ThreeRevisionError unless the three.js in use is the release this package was built for. */
@@ -95,7 +95,7 @@ export async function createCreaturePopulation(renderer, options = {}) {
   const surface = await loadSurface(resolveSurfaceUrl(options, defaultSurfaceUrl));
   const geometry = surfaceGeometry(surface);
   const layout = layoutOf(data);
-  const programs = programStorage(data);
+  const programs = programStorage(surface);
   const records = vertexRecords(geometry);
   const vertices = layout.vertices;
   // A page's deform storage is one binding: it must fit the device's maxStorageBufferBindingSize.
