@@ -44,8 +44,7 @@ POSE_ROWS: Final = 5
 def as_pose(quats: Sequence[Sequence[float]], trans: Sequence[Sequence[float]]) -> Pose:
     """Per-slot quaternions (xyzw) and translations as a rotations.Pose (what the numpy skinning consumes)."""
     q = np.asarray(quats, dtype=np.float64)
-    wxyz = np.concatenate([q[:, 3:4], q[:, :3]], axis=1)
-    return Pose(quaternion_to_matrix(wxyz), np.asarray(trans, dtype=np.float64))
+    return Pose(quaternion_to_matrix(q), np.asarray(trans, dtype=np.float64))
 
 
 def sized_graph(graph: BlendGraph, size: float) -> BlendGraph:

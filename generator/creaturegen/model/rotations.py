@@ -1,14 +1,19 @@
 """Poses of the slot table: per-slot rigid transforms, the rotations that build them, and quaternions.
 
-A pose carries each slot from rest to its posed place, ``x' = R·x + t``. Quaternions here are (w, x, y, z)
-and unit, with w ≥ 0 when converted from a matrix; the motion core's own quaternions (motion/quat.py) are
-(x, y, z, w), the order of three.js and of the shipped JS.
+A pose carries each slot from rest to its posed place, ``x' = R·x + t``. Quaternions are (x, y, z, w)
+everywhere in creaturegen: here, in the motion core (motion/quat.py), in three.js and in the shipped JS
+and WGSL. Unit, with w ≥ 0 when converted from a matrix.
+
+Sums over a quaternion's four components (:func:`quaternion_dot`, :func:`quaternion_norm`) add w first,
+then x, y, z: the order the surface reference has always summed in, so its skinned positions and the
+gate figures recorded from them keep their last bit when the storage order changed.
 """
 
 from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import Final
 
 import numpy as np
 import numpy.typing as npt
@@ -16,6 +21,9 @@ import numpy.typing as npt
 from . import layout as col
 
 F64 = npt.NDArray[np.float64]
+
+#: Multiplying by this conjugates a unit quaternion (its inverse).
+CONJUGATE: Final = np.array([-1.0, -1.0, -1.0, 1.0])
 
 
 @dataclass(frozen=True)
@@ -110,16 +118,17 @@ def matrix_to_quaternion(rotations: F64) -> F64:
             ],
             axis=1,
         )
-    q = candidates[np.arange(m.shape[0]), case]
-    q = q / np.linalg.norm(q, axis=1, keepdims=True)
-    q = np.where(q[:, :1] < 0, -q, q)
+    # Shepperd's cases are written w-first (as the literature does); stored x, y, z, w.
+    q = candidates[np.arange(m.shape[0]), case][:, [1, 2, 3, 0]]
+    q = q / quaternion_norm(q)[:, None]
+    q = np.where(q[:, 3:] < 0, -q, q)
     result: F64 = q.reshape(*np.shape(rotations)[:-2], 4)
     return result
 
 
 def quaternion_to_matrix(q: F64) -> F64:
-    """(..., 4) unit quaternions → (..., 3, 3); (1, 0, 0, 0) maps to the identity exactly."""
-    w, x, y, z = q[..., 0], q[..., 1], q[..., 2], q[..., 3]
+    """(..., 4) unit quaternions → (..., 3, 3); (0, 0, 0, 1) maps to the identity exactly."""
+    x, y, z, w = q[..., 0], q[..., 1], q[..., 2], q[..., 3]
     result: F64 = np.stack(
         [
             np.stack([1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)], axis=-1),
@@ -132,15 +141,29 @@ def quaternion_to_matrix(q: F64) -> F64:
 
 
 def quaternion_multiply(a: F64, b: F64) -> F64:
-    aw, ax, ay, az = a[..., 0], a[..., 1], a[..., 2], a[..., 3]
-    bw, bx, by, bz = b[..., 0], b[..., 1], b[..., 2], b[..., 3]
+    """Hamilton product ``a·b`` (apply b, then a)."""
+    ax, ay, az, aw = a[..., 0], a[..., 1], a[..., 2], a[..., 3]
+    bx, by, bz, bw = b[..., 0], b[..., 1], b[..., 2], b[..., 3]
     result: F64 = np.stack(
         [
-            aw * bw - ax * bx - ay * by - az * bz,
             aw * bx + ax * bw + ay * bz - az * by,
             aw * by - ax * bz + ay * bw + az * bx,
             aw * bz + ax * by - ay * bx + az * bw,
+            aw * bw - ax * bx - ay * by - az * bz,
         ],
         axis=-1,
     )
+    return result
+
+
+def quaternion_dot(a: F64, b: F64) -> F64:
+    """Four-component dot product over the last axis, summed w first (see the module docstring)."""
+    ww = a[..., 3] * b[..., 3]
+    result: F64 = ((ww + a[..., 0] * b[..., 0]) + a[..., 1] * b[..., 1]) + a[..., 2] * b[..., 2]
+    return result
+
+
+def quaternion_norm(q: F64) -> F64:
+    """Length over the last axis, summed w first (see the module docstring)."""
+    result: F64 = np.sqrt(quaternion_dot(q, q))
     return result

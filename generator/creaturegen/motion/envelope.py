@@ -52,7 +52,7 @@ from ..codedigest import stage_digest
 from ..model import layout as col
 from ..model.genome import MAX_GAIT_GENES, Genome
 from ..model.lcg import instance_yaw
-from ..model.rotations import Pose, quaternion_multiply, quaternion_to_matrix
+from ..model.rotations import CONJUGATE, Pose, quaternion_multiply, quaternion_to_matrix
 from ..model.skeleton import Skeleton, joint_frame
 from .compiled import CompiledCreature
 from .data import MotionData
@@ -255,7 +255,7 @@ def individual(data: MotionData, support: Support, seed: int, genome: Genome | N
 
 
 def _step_run(motion: Motion, ticks: int) -> tuple[F64, F64]:
-    """One run's samples: quaternions (ticks + 1, S, 4) wxyz and translations (ticks + 1, S, 3) of the
+    """One run's samples: quaternions (ticks + 1, S, 4) and translations (ticks + 1, S, 3) of the
     unit body (the individual's divided by its size), tick 0 first."""
     quats: list[float] = []
     trans: list[float] = []
@@ -265,9 +265,9 @@ def _step_run(motion: Motion, ticks: int) -> tuple[F64, F64]:
         quats.extend(itertools.chain.from_iterable(motion.quats))
         trans.extend(itertools.chain.from_iterable(motion.trans))
     slots = len(motion.quats)
-    xyzw = np.asarray(quats, dtype=np.float64).reshape(ticks + 1, slots, 4)
+    q: F64 = np.asarray(quats, dtype=np.float64).reshape(ticks + 1, slots, 4)
     unit: F64 = np.asarray(trans, dtype=np.float64).reshape(ticks + 1, slots, 3) / motion.size
-    return xyzw[..., [3, 0, 1, 2]], unit
+    return q, unit
 
 
 #: In a forked worker: the runs it may step and the ticks per run (its copy of the parent's).
@@ -315,7 +315,7 @@ def _step_runs(motions: list[Motion], ticks: int, workers: int) -> list[tuple[F6
 def _record(
     data: MotionData, runs: list[tuple[str, Motion]], workers: int = 1
 ) -> tuple[list[str], int, F64, F64, list[str]]:
-    """(run labels, ticks per run, quaternions (N, S, 4) wxyz, translations (N, S, 3) of the unit body,
+    """(run labels, ticks per run, quaternions (N, S, 4), translations (N, S, 3) of the unit body,
     sample labels)."""
     ticks = run_ticks(data, len(runs))
     return _recorded(runs, ticks, _step_runs([motion for _, motion in runs], ticks, workers))
@@ -334,7 +334,7 @@ def _recorded(
 
 def _root_frame(quats: F64, trans: F64, root: int) -> tuple[F64, F64]:
     """Every slot's transform composed with the inverse of ``root``'s: the pose modulo rigid motion."""
-    inverse = quats[:, root : root + 1] * np.array([1.0, -1.0, -1.0, -1.0])
+    inverse = quats[:, root : root + 1] * CONJUGATE
     q = quaternion_multiply(np.broadcast_to(inverse, quats.shape), quats)
     r_inv = quaternion_to_matrix(inverse)
     t = np.einsum(
@@ -348,12 +348,11 @@ def _joint(
 ) -> JointEnvelope:
     """Swing and twist of the child relative to its parent at every sample; the worst of each, and the
     run (``runs``: each sample's) where the larger of the two peaks."""
-    inverse = q[:, parent] * np.array([1.0, -1.0, -1.0, -1.0])
-    rel = quaternion_multiply(inverse, q[:, child])
-    rel = np.where(rel[:, :1] < 0.0, -rel, rel)
+    rel = quaternion_multiply(q[:, parent] * CONJUGATE, q[:, child])
+    rel = np.where(rel[:, 3:] < 0.0, -rel, rel)
     tangent, _, _ = joint_frame(skeleton, rest, child)
-    along = rel[:, 1:] @ tangent
-    twist = 2.0 * np.arctan2(np.abs(along), rel[:, 0])
+    along = rel[:, :3] @ tangent
+    twist = 2.0 * np.arctan2(np.abs(along), rel[:, 3])
     turned = np.einsum("nij,j->ni", quaternion_to_matrix(rel), tangent)
     bend = np.arccos(np.clip(turned @ tangent, -1.0, 1.0))
     # The pivot carried by the child's transform and by the parent's must coincide.

@@ -18,7 +18,8 @@ These are the float64 formulas the shipped runtime mirrors (templates/creature/t
 reference re-skins with (creature/reference.py); which method each joint gets is chosen in
 surface/deform.py by sweeping the joint (surface/sweep.py).
 
-Conventions: a pose maps rest to posed, per slot ``x' = R_s x + t_s``; quaternions are ``(w, x, y, z)``.
+Conventions: a pose maps rest to posed, per slot ``x' = R_s x + t_s``; quaternions are ``(x, y, z, w)``
+(model/rotations.py).
 """
 
 from __future__ import annotations
@@ -31,7 +32,15 @@ from typing import Final, Literal
 import numpy as np
 import numpy.typing as npt
 
-from ..model.rotations import Pose, matrix_to_quaternion, quaternion_multiply, quaternion_to_matrix
+from ..model.rotations import (
+    CONJUGATE,
+    Pose,
+    matrix_to_quaternion,
+    quaternion_dot,
+    quaternion_multiply,
+    quaternion_norm,
+    quaternion_to_matrix,
+)
 from ..model.skeleton import Skeleton
 from .mesh import Mesh, unit_rows
 
@@ -52,9 +61,9 @@ COR_CHUNK: Final = 4096
 
 
 def _dual_quaternions(pose: Pose) -> tuple[F64, F64]:
-    """Per slot real part q and dual part ½·(0, t)·q."""
+    """Per slot real part q and dual part ½·(t, 0)·q."""
     real = matrix_to_quaternion(pose.rotations)
-    pure = np.concatenate([np.zeros((pose.slot_count, 1)), pose.translations], axis=1)
+    pure = np.concatenate([pose.translations, np.zeros((pose.slot_count, 1))], axis=1)
     return real, 0.5 * quaternion_multiply(pure, real)
 
 
@@ -69,7 +78,7 @@ def _hemisphere(quaternions: F64, weights: F64) -> tuple[F64, int]:
     """
     dominant = np.argmax(weights, axis=1)
     reference = quaternions[np.arange(quaternions.shape[0]), dominant]
-    dots = np.einsum("vkc,vc->vk", quaternions, reference)
+    dots = quaternion_dot(quaternions, reference[:, None, :])
     flipped = dots < 0
     return np.where(flipped, -1.0, 1.0), int(np.count_nonzero(flipped & (weights > 0)))
 
@@ -123,10 +132,9 @@ def dq_blend(vertices: F64, indices: I64, weights: F64, pose: Pose) -> tuple[F64
     sw = weights * signs
     br = np.einsum("vk,vkc->vc", sw, qr)
     bd = np.einsum("vk,vkc->vc", sw, qd)
-    norm = np.linalg.norm(br, axis=1, keepdims=True)
+    norm = quaternion_norm(br)[:, None]
     br, bd = br / norm, bd / norm
-    conj = br * np.array([1.0, -1.0, -1.0, -1.0])
-    translation = 2.0 * quaternion_multiply(bd, conj)[:, 1:]
+    translation = 2.0 * quaternion_multiply(bd, br * CONJUGATE)[:, :3]
     rotation = quaternion_to_matrix(br)
     return np.einsum("vij,vj->vi", rotation, vertices) + translation, rotation, flips
 
@@ -139,7 +147,9 @@ def cor_blend(vertices: F64, indices: I64, weights: F64, pose: Pose, centers: F6
     """
     q = matrix_to_quaternion(pose.rotations)[indices]
     signs, flips = _hemisphere(q, weights)
-    blended = unit_rows(np.einsum("vk,vkc->vc", weights * signs, q))
+    summed = np.einsum("vk,vkc->vc", weights * signs, q)
+    length = quaternion_norm(summed)[:, None]
+    blended = summed / np.where(length > 0, length, 1.0)
     rotation = quaternion_to_matrix(blended)
     delta = np.einsum("vk,vkij->vij", weights, (pose.rotations - np.eye(3))[indices])
     shift = np.einsum("vk,vki->vi", weights, pose.translations[indices])
