@@ -230,7 +230,10 @@ export interface CreatureData {
   readonly slotLab: readonly Vec3[];
   readonly motion: MotionData;
   readonly tickRate: number;
-  readonly programData: readonly number[];
+  /** sha256 of the program tapes the .glb carries (surface/glb.py `program_digest`), checked on load. */
+  readonly programDigest: string;
+  /** Their length in vec4 rows: a header per program, then every instruction. */
+  readonly programRows: number;
   readonly programCount: number;
   readonly fullProgram: number;
   readonly registers: number;
@@ -286,14 +289,16 @@ export function hashBytes(bytes: Uint8Array | Uint8Array[], tick: number): strin
 export interface ParsedSurface {
   attributes: Record<string, { array: Float32Array | Uint16Array | Uint32Array; itemSize: number }>;
   index: { array: Uint16Array | Uint32Array };
-  /** The glTF asset.extras: the build's signatures (geometryDigest, topologySignature, compilerSignature, tier). */
+  /** The candidate program tapes (vec4 rows: a header per program, then instructions); null in a .glb without them. */
+  program: Float32Array | null;
+  /** The glTF asset.extras: the build's signatures (geometryDigest, topologySignature, compilerSignature, tier, programDigest). */
   extras: Record<string, unknown>;
 }
 /** `source` names the file in errors. */
 export function parseGlb(buffer: ArrayBuffer, source?: string): ParsedSurface;
 
 /** The signatures a surface .glb must carry to be this package's, compared when it loads. */
-export type SurfaceKey = 'geometryDigest' | 'topologySignature' | 'compilerSignature' | 'tier';
+export type SurfaceKey = 'geometryDigest' | 'topologySignature' | 'compilerSignature' | 'tier' | 'programDigest';
 export type SurfaceSignatures = Record<SurfaceKey, string | null>;
 export const SURFACE_KEYS: readonly SurfaceKey[];
 /** The fetched .glb is not this package's surface: `expected` are the package's signatures, `found` the file's. */

@@ -2,13 +2,13 @@
 // Where this package's reference surface is by default: next to the package, as one static
 // `new URL('<literal>', import.meta.url)` expression. Vite (build), webpack 5, Parcel and Rollup's
 // import-meta-assets plugin recognise exactly this form and copy the file with the bundle. The name is
-// unique per package and geometry (<slug>-<geometryDigest[:12]>.glb), so asset folders merged by a copy
+// unique per package, geometry and programs (<slug>-<digest[:12]>.glb), so asset folders merged by a copy
 // step never hand one creature another's mesh; core/surface.js checks the signatures either way.
 
 /** The .glb's file name (also CREATURE.surfaceFile): what to copy next to `assetBase`. */
-export const SURFACE_FILE = "hopper-squash-core-400b0d18a2a9.glb";
+export const SURFACE_FILE = "hopper-squash-core-4ad943085362.glb";
 
 /** The package's own copy of the surface, resolved against this module. */
 export function defaultSurfaceUrl() {
-  return new URL("../assets/hopper-squash-core-400b0d18a2a9.glb", import.meta.url).href;
+  return new URL("../assets/hopper-squash-core-4ad943085362.glb", import.meta.url).href;
 }
