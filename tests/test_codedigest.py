@@ -8,7 +8,7 @@ from pathlib import Path
 
 import pytest
 
-from creaturegen.codedigest import PACKAGE_ROOT, code_closure, code_digest
+from creaturegen.codedigest import PACKAGE_ROOT, memo_key, code_closure, code_digest
 from creaturegen.surface.identity import SURFACE_ENTRY
 
 ENVELOPE = "creaturegen.motion.envelope"
@@ -71,3 +71,25 @@ def test_a_module_only_the_surface_runs_keeps_the_envelope_digest(copy: Path) ->
     _edit(copy / "surface" / "posed.py", "FOLD_DEG: Final = 90.0", "FOLD_DEG: Final = 91.0")
     assert code_digest(SURFACE_ENTRY, copy) != before[SURFACE_ENTRY]
     assert code_digest(ENVELOPE, copy) == before[ENVELOPE]
+
+
+def test_the_memo_gives_the_computed_digest_and_forgets_an_edited_file(copy: Path, tmp_path: Path) -> None:
+    """Builds remember each module's result by its exact bytes (the parse costs 0.6 s a build): a memo
+    hit is the computed digest, any edited byte is parsed again, and a damaged memo entry is ignored."""
+    memo = tmp_path / "memo"
+    plain = code_digest(SURFACE_ENTRY, copy)
+    assert code_digest(SURFACE_ENTRY, copy, memo) == plain  # written
+    entries = sorted(memo.glob("*.json"))
+    assert len(entries) == len(code_closure(SURFACE_ENTRY, copy))
+    assert code_digest(SURFACE_ENTRY, copy, memo) == plain  # read back
+    # Damaged entries are recomputed, not believed.
+    entries[0].write_text("{not json")
+    entries[1].write_text('{"digest": 1, "imports": []}')
+    assert code_digest(SURFACE_ENTRY, copy, memo) == plain
+    # A code edit misses the memo and changes the digest exactly as without it.
+    _edit(copy / "surface" / "posed.py", "FOLD_DEG: Final = 90.0", "FOLD_DEG: Final = 91.0")
+    assert code_digest(SURFACE_ENTRY, copy, memo) == code_digest(SURFACE_ENTRY, copy) != plain
+    # A planted wrong entry for posed.py's current bytes is believed: the memo is keyed by those bytes.
+    key = memo_key("creaturegen.surface.posed", (copy / "surface" / "posed.py").read_bytes())
+    (memo / f"{key}.json").write_text('{"digest": "planted", "imports": []}')
+    assert code_digest(SURFACE_ENTRY, copy, memo) != code_digest(SURFACE_ENTRY, copy)

@@ -6,18 +6,42 @@ every compilerSignature, empty the surface cache and break the golden record. He
 module; the digest covers the creaturegen modules reachable from it through ``import`` statements
 anywhere in their text (module level or inside functions), each parsed and dumped without docstrings,
 so comments, docstrings and formatting never count while every statement, constant and name does.
+
+Parsing and dumping ~100 modules costs about 0.6 s, which every build paid twice (issue 26's pipeline
+benchmark, bench/pipeline.py, found builds 0.7 s slower than before the stage keys). So each module's
+result (the digest of its prose-free tree, and what it imports) is remembered in the cache folder under
+the sha256 of its exact bytes, its name and the Python release (``ast.dump`` differs between releases):
+a file that changed in any byte is parsed again, an unchanged one is read back. The digests are the same
+with or without the memo; a memo file that cannot be read or written is ignored.
 """
 
 from __future__ import annotations
 
 import ast
 import hashlib
+import json
+import os
+import sys
+import tempfile
+from dataclasses import dataclass
 from functools import cache
 from pathlib import Path
+
+from .cachedir import default_cache_root
 
 #: The package root the digests read (the installed or checked-out creaturegen).
 PACKAGE_ROOT = Path(__file__).resolve().parent
 PACKAGE = "creaturegen"
+#: Bumped when what a module's entry holds, or how it is computed, changes.
+MEMO_VERSION = "1"
+
+
+@dataclass(frozen=True)
+class ModuleCode:
+    """One module's part of a stage digest."""
+
+    digest: str  # sha256 of its syntax tree without prose
+    imports: frozenset[str]  # imported_modules of its text
 
 
 def module_path(module: str, root: Path = PACKAGE_ROOT) -> Path | None:
@@ -67,8 +91,52 @@ def _without_prose(tree: ast.Module) -> str:
     return ast.dump(tree, include_attributes=False)
 
 
-def code_closure(entry: str, root: Path = PACKAGE_ROOT) -> dict[str, str]:
-    """{module: its code without prose} for ``entry`` and every creaturegen module it reaches."""
+def memo_key(module: str, source: bytes) -> str:
+    release = f"{sys.version_info[0]}.{sys.version_info[1]}"
+    head = f"creaturegen-code {MEMO_VERSION} {release} {module}\0".encode()
+    return hashlib.sha256(head + source).hexdigest()
+
+
+def _recall(memo: Path, key: str) -> ModuleCode | None:
+    try:
+        entry = json.loads((memo / f"{key}.json").read_text(encoding="utf-8"))
+        digest, imports = entry["digest"], entry["imports"]
+        if not (isinstance(digest, str) and isinstance(imports, list)):
+            return None
+        return ModuleCode(digest, frozenset(str(name) for name in imports))
+    except (OSError, ValueError, KeyError, TypeError):
+        return None
+
+
+def _remember(memo: Path, key: str, code: ModuleCode) -> None:
+    text = json.dumps({"digest": code.digest, "imports": sorted(code.imports)})
+    try:
+        memo.mkdir(parents=True, exist_ok=True)
+        fd, temporary = tempfile.mkstemp(dir=memo, prefix=f".{key}.", suffix=".tmp")
+        with os.fdopen(fd, "w", encoding="utf-8") as handle:
+            handle.write(text)
+        os.replace(temporary, memo / f"{key}.json")
+    except OSError:
+        pass
+
+
+def module_code(module: str, path: Path, memo: Path | None = None) -> ModuleCode:
+    """``module``'s digest and imports, read from ``memo`` when its exact bytes were seen before."""
+    source = path.read_bytes()
+    key = memo_key(module, source)
+    known = _recall(memo, key) if memo is not None else None
+    if known is not None:
+        return known
+    tree = ast.parse(source.decode("utf-8"), filename=str(path))
+    imports = frozenset(imported_modules(tree, module, path.name == "__init__.py"))
+    code = ModuleCode(hashlib.sha256(_without_prose(tree).encode()).hexdigest(), imports)
+    if memo is not None:
+        _remember(memo, key, code)
+    return code
+
+
+def code_closure(entry: str, root: Path = PACKAGE_ROOT, memo: Path | None = None) -> dict[str, str]:
+    """{module: digest of its code without prose} for ``entry`` and every creaturegen module it reaches."""
     seen: dict[str, str] = {}
     todo = [entry]
     while todo:
@@ -78,24 +146,24 @@ def code_closure(entry: str, root: Path = PACKAGE_ROOT) -> dict[str, str]:
         path = module_path(module, root)
         if path is None:
             continue
-        tree = ast.parse(path.read_text(encoding="utf-8"), filename=str(path))
-        seen[module] = _without_prose(tree)
-        todo.extend(imported_modules(tree, module, path.name == "__init__.py") - set(seen))
+        code = module_code(module, path, memo)
+        seen[module] = code.digest
+        todo.extend(code.imports - set(seen))
     return seen
 
 
-def code_digest(entry: str, root: Path = PACKAGE_ROOT) -> str:
+def code_digest(entry: str, root: Path = PACKAGE_ROOT, memo: Path | None = None) -> str:
     """sha256 over :func:`code_closure`, in module order."""
     h = hashlib.sha256()
-    for module, code in sorted(code_closure(entry, root).items()):
+    for module, digest in sorted(code_closure(entry, root, memo).items()):
         h.update(module.encode())
         h.update(b"\0")
-        h.update(code.encode())
+        h.update(digest.encode())
         h.update(b"\0")
     return h.hexdigest()
 
 
 @cache
 def stage_digest(entry: str) -> str:
-    """:func:`code_digest` of the installed package, once per process."""
-    return code_digest(entry)
+    """:func:`code_digest` of the installed package, once per process, with the memo in the cache folder."""
+    return code_digest(entry, memo=default_cache_root() / "code")
