@@ -117,7 +117,7 @@ export const CREATURE = Object.freeze({
   "registers": 13,
   "roundCone": [0, 0, 0, 0, 0, 0, 0],
   "signatures": {
-    "compilerSignature": "bf3bf96e5b2c6264e05b44fecefb6ef108e5bd22be881649e40a593f814d49d6",
+    "compilerSignature": "aa8c35a631ece7d992c581cbb5ab480dbc5ac282aaac208657da003e1fdad0c2",
     "geometryDigest": "400b0d18a2a9f6bbbfe5b441f89767f552a4f3b4c45a368d1129d632e1d2f4f1",
     "topologySignature": "330d551e8c006f84b01459c84db69ca8c43aec5bc9d9083d3e85c291be5a68bf"
   },
