@@ -8,7 +8,7 @@ from pathlib import Path
 
 import pytest
 
-from creaturegen.codedigest import PACKAGE_ROOT, memo_key, code_closure, code_digest
+from creaturegen.codedigest import PACKAGE_ROOT, code_closure, code_digest, memo_key
 from creaturegen.surface.identity import SURFACE_ENTRY
 
 ENVELOPE = "creaturegen.motion.envelope"

@@ -377,6 +377,45 @@ def test_the_job_catches_a_spawn_that_spreads_bodies_over_pages(out_root: Path, 
     assert f"pose pages in use after {SPAWNS} spawns of pageSize {PAGE_SIZE}" in failed, report.summary()
 
 
+MOVED_GATE = "bodies deformed by a tick that moves every live body (pre-pass: all of them)"
+STILL_GATE = "bodies deformed by a frame in which no pose changed (pre-pass: only what moved)"
+SPAWN_GATE = "bodies deformed by a frame whose only change is one spawn beside still bodies (only what moved)"
+
+
+@pytest.mark.browser
+@pytest.mark.parametrize(
+    ("planted_defect", "swap", "gate", "quiet"),
+    [
+        (
+            "a pre-pass over every live body, moved or not",
+            (
+                "if (page.moved[j] && page.alive[j]) page.listed[n++] = j;",
+                "if (page.alive[j]) page.listed[n++] = j;",
+            ),
+            SPAWN_GATE,
+            MOVED_GATE,
+        ),
+        (
+            "a change test that compares the new rows with themselves (no body ever moves)",
+            ("changed = rows[base + i] !== previous[i];", "changed = rows[base + i] !== rows[base + i];"),
+            MOVED_GATE,
+            STILL_GATE,
+        ),
+    ],
+)
+def test_the_job_catches_a_pre_pass_that_ignores_what_moved(
+    out_root: Path, tmp_path: Path, planted_defect: str, swap: tuple[str, str], gate: str, quiet: str
+) -> None:
+    """The pre-pass runs only the bodies whose pose rows changed since their last pre-pass: a flush that
+    deforms every live body of a changed page fails the one-spawn gate, one that never sees a change fails
+    the all-moved gate; each leaves the other's quiet gate alone."""
+    package = build("reference/hopper.json", out_root)
+    report = run_creature_parity(_planted(package, tmp_path, "staging.js", [swap]), groups=("population",))
+    failed, summary = {g["name"] for g in report.gates if g["status"] == "fail"}, report.summary()
+    assert gate in failed, (planted_defect, summary)
+    assert quiet not in failed, (planted_defect, summary)
+
+
 @pytest.mark.browser
 def test_the_job_catches_a_page_drawn_twice_in_a_pass(out_root: Path, tmp_path: Path) -> None:
     """A second mesh per page over the same geometry and material (an outline proxy, say) keeps the pages

@@ -8,6 +8,7 @@ give) vs its Python reference, no two individuals alike; parity/grid.png shows t
 from __future__ import annotations
 
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 from playwright.sync_api import Page
@@ -80,6 +81,30 @@ def counter_gates(page: Page, report: ParityReport) -> None:
         "passes",
         passed=len(body_passes) >= 2,
     )
+    moved = telemetry["stats"]["lastFrameDeformedBodies"]
+    report.gate(
+        "bodies deformed by a tick that moves every live body (pre-pass: all of them)",
+        abs(moved - telemetry["count"]),
+        0,
+        "bodies",
+    )
+    still = still_frame(page)
+    report.gate(
+        "bodies deformed by a frame in which no pose changed (pre-pass: only what moved)",
+        still["stats"]["lastFrameDeformedBodies"] + still["stats"]["lastFrameDeformedVertices"],
+        0,
+        "bodies",
+    )
+    # One spawn beside bodies that stand still (no step): its page holds another body, so a pre-pass over
+    # the page's changed range, or over every live body, runs more than the one that moved.
+    page.evaluate("() => window.__lab.spawn(2000, 1, 1.5, true)")
+    spawned = page.evaluate("() => window.__lab.telemetry()")["stats"]["lastFrameDeformedBodies"]
+    report.gate(
+        "bodies deformed by a frame whose only change is one spawn beside still bodies (only what moved)",
+        abs(spawned - 1),
+        0,
+        "bodies",
+    )
     report.measurements["population"] = {
         "count": telemetry["count"],
         "pagesInUse": pages,
@@ -90,6 +115,16 @@ def counter_gates(page: Page, report: ParityReport) -> None:
         "sinceReveal": after,
     }
     page.evaluate("() => window.__lab.despawnAll([0])")
+
+
+def still_frame(page: Page) -> dict[str, Any]:
+    """A frame of no time after another (update(0) twice: no step, the same interpolation): every pose
+    row is what the last frame wrote, so the pre-pass must run no body and the upload must be empty. The
+    drawn surface stays the one stored (the skin gates read it after this frame)."""
+    page.evaluate("() => window.__lab.update(0)")  # the render pose between the last two steps
+    page.evaluate("() => window.__lab.update(0)")  # the same pose again
+    telemetry: dict[str, Any] = page.evaluate("() => window.__lab.telemetry()")
+    return telemetry
 
 
 def grid_gates(page: Page, ref: cref.PackageReference, package: Path, report: ParityReport) -> None:

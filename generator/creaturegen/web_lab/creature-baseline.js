@@ -149,6 +149,6 @@ export function baselineFunctions(tsl, layout, pose, programs, step) {
 export function createBaselineKernel(tsl, layout, page, records, programs, step) {
   const fns = baselineFunctions(tsl, layout, page.pose, programs, step);
   return tsl.createDeformKernel(layout, fns, {
-    pose: page.pose, records, deform: page.deform, size: page.size, vertices: layout.vertices,
+    pose: page.pose, records, deform: page.deform, list: page.list, size: page.size, vertices: layout.vertices,
   });
 }

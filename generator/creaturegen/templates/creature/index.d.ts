@@ -66,6 +66,8 @@ export interface CreaturePopulation {
     uploads: number; uploadBytes: number; lastFrameBytes: number; spawns: number; ticks: number;
     /** Deform pre-pass dispatches so far, and the vertices the last flush deformed. */
     deformDispatches: number; lastFrameDeformedVertices: number;
+    /** Bodies the last flush re-deformed: those whose pose rows changed since their last pre-pass. */
+    lastFrameDeformedBodies: number;
   };
   /** One pose page: its body mesh (one draw per pass) and, once debug mode 'shell' was shown, its shell. */
   readonly pages: { mesh: Mesh; shell: Mesh | null }[];

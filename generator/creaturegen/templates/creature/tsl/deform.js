@@ -4,7 +4,7 @@
 // stored position, so the shadow is cast by the very surface that is seen, and no vertex is skinned or
 // evaluated twice in a frame (a vertex stage would re-run the whole path per pass, and per re-shaded
 // vertex on a rasteriser without a post-transform cache, such as SwiftShader).
-import { Fn, If, float, instanceIndex, instancedArray, int, storage, uniform, vec4 } from 'three/tsl';
+import { Fn, If, instanceIndex, instancedArray, int, storage, vec4 } from 'three/tsl';
 import { bodyVertex } from './body.js';
 
 /** vec4 per drawn vertex: (position, distance), (gradient, accepted), (albedo, program); creaturegen's
@@ -60,18 +60,25 @@ export function deformView(deform) {
   return storage(deform.value, 'vec4', deform.value.count).toReadOnly();
 }
 
+/** A page's instance list: the bodies the next pre-pass runs, one int each (filled by the population). */
+export function instanceList(size) {
+  return instancedArray(new Int32Array(size), 'int');
+}
+
 /**
- * The deform kernel of one page over `fns` (bodyFunctions, or a lab baseline's). Dispatch it with
- * dispatchDeform, which limits it to a range of instances; dead instances are skipped (the vertex stage
- * draws them collapsed to the origin).
+ * The deform kernel of one page over `fns` (bodyFunctions, or a lab baseline's). It runs the bodies named
+ * by the first `count` entries of the page's instance `list` (dispatchDeform), each into its own slice of
+ * the deform storage, so a body left out keeps what it stored last: the population lists only the bodies
+ * whose pose rows changed since their last pre-pass. Dead instances are skipped (the vertex stage draws
+ * them collapsed to the origin).
  */
-export function createDeformKernel(layout, fns, { pose, records, deform, size, vertices, skinOnly = false }) {
-  const first = uniform(0, 'int');
+export function createDeformKernel(layout, fns, { pose, records, deform, list, size, vertices, skinOnly = false }) {
   const rowsPerInstance = layout.maxParts * layout.rows;
   const kernel = Fn(() => {
-    const idx = int(instanceIndex).add(first.mul(vertices)).toVar();
-    const j = idx.div(vertices).toVar();
-    const v = idx.sub(j.mul(vertices)).toVar();
+    const entry = int(instanceIndex).div(vertices).toVar();
+    const v = int(instanceIndex).sub(entry.mul(vertices)).toVar();
+    const j = list.element(entry).toVar();
+    const idx = j.mul(vertices).add(v).toVar();
     const base = j.mul(rowsPerInstance).toVar();
     const alive = pose.element(base.add(layout.slotCount * layout.rows)).w;
     If(alive.greaterThan(0.5), () => {
@@ -83,15 +90,14 @@ export function createDeformKernel(layout, fns, { pose, records, deform, size, v
     });
   })().compute(size * vertices);
   kernel.setName(skinOnly ? 'cgDeformSkinOnly' : 'cgDeform');
-  return { kernel, first, vertices, size };
+  return { kernel, list, vertices, size };
 }
 
-/** Run `deform` over instances lo..hi of its page (inclusive); returns the vertices processed. */
-export function dispatchDeform(renderer, deform, lo, hi) {
-  const count = (hi - lo + 1) * deform.vertices;
-  if (count <= 0) return 0;
-  deform.first.value = lo;
-  deform.kernel.count = count;
+/** Run `deform` over the first `count` bodies of its page's instance list; returns the vertices processed. */
+export function dispatchDeform(renderer, deform, count) {
+  const n = count * deform.vertices;
+  if (n <= 0) return 0;
+  deform.kernel.count = n;
   renderer.compute(deform.kernel);
-  return count;
+  return n;
 }

@@ -1,7 +1,7 @@
 // Types of the three/TSL adapter (`<package>/tsl`): the population API (declared by the package entry,
 // index.d.ts) and the node builders it is made of. Needs @types/three (an optional peer dependency).
 import type {
-  BufferGeometry, ComputeNode, Mesh, MeshStandardNodeMaterial, Node, StorageBufferNode, UniformNode, WebGPURenderer,
+  BufferGeometry, ComputeNode, Mesh, MeshStandardNodeMaterial, Node, StorageBufferNode, WebGPURenderer,
 } from 'three/webgpu';
 import type { CreatureData, DebugMode, ParsedSurface } from '../core/index.js';
 
@@ -70,16 +70,18 @@ export function bodyVertex(layout: Layout, fns: BodyFunctions, inputs: VertexInp
 export const DEFORM_STRIDE: number;
 /** vec4 per rest vertex in the vertex records. */
 export const RECORD_STRIDE: number;
-export interface DeformKernel { kernel: ComputeNode; first: UniformNode<'int', number>; vertices: number; size: number }
+export interface DeformKernel { kernel: ComputeNode; list: PoseStorage; vertices: number; size: number }
 export function vertexRecords(geometry: BufferGeometry): PoseStorage;
 export function recordInputs(records: PoseStorage, v: Node): VertexInputs;
 export function deformStorage(size: number, vertices: number): PoseStorage;
 export function deformView(deform: PoseStorage): PoseStorage;
+/** A page's instance list (one int per body): the bodies the next pre-pass runs. */
+export function instanceList(size: number): PoseStorage;
 export function createDeformKernel(layout: Layout, fns: BodyFunctions, options: {
-  pose: PoseStorage; records: PoseStorage; deform: PoseStorage; size: number; vertices: number; skinOnly?: boolean;
+  pose: PoseStorage; records: PoseStorage; deform: PoseStorage; list: PoseStorage; size: number; vertices: number; skinOnly?: boolean;
 }): DeformKernel;
-/** Run `deform` over instances lo..hi of its page (inclusive); returns the vertices processed. */
-export function dispatchDeform(renderer: WebGPURenderer, deform: DeformKernel, lo: number, hi: number): number;
+/** Run `deform` over the first `count` bodies of its page's instance list; returns the vertices processed. */
+export function dispatchDeform(renderer: WebGPURenderer, deform: DeformKernel, count: number): number;
 
 /** Throws unless `mode` is one of DEBUG_MODES; returns it. */
 export function checkDebugMode(mode: string): DebugMode;

@@ -4,7 +4,8 @@ export { OP, createField, rootSize } from './field.js';
 export { METHOD, createSkin, rotate } from './skin.js';
 export { NO_PROGRAM, SKIN_PROGRAM, bodyFunctions, bodyVertex, layoutOf } from './body.js';
 export {
-  DEFORM_STRIDE, RECORD_STRIDE, createDeformKernel, deformStorage, deformView, dispatchDeform, recordInputs, vertexRecords,
+  DEFORM_STRIDE, RECORD_STRIDE, createDeformKernel, deformStorage, deformView, dispatchDeform, instanceList, recordInputs,
+  vertexRecords,
 } from './deform.js';
 export { DEBUG_MODES, checkDebugMode, createBodyMaterial, rootNormal, rootPoint, rootRotate } from './material.js';
 export { createShellMesh } from './shell.js';

@@ -6,7 +6,7 @@ import * as THREE from 'three/webgpu';
 import { instancedArray } from 'three/tsl';
 import { GENOME_LENGTH } from '../core/genome.js';
 import { bodyFunctions } from './body.js';
-import { createDeformKernel, deformStorage, deformView } from './deform.js';
+import { createDeformKernel, deformStorage, deformView, instanceList } from './deform.js';
 import { createBodyMaterial } from './material.js';
 import { createShellMesh } from './shell.js';
 
@@ -25,8 +25,12 @@ export function createPages(state) {
     mesh.name = `${data.slug}.page${pages.length}`;
     group.add(mesh);
     const deform = deformStorage(size, vertices);
+    const list = instanceList(size);
     pages.push({
       first, size, pose, mesh, staging: pose.value.array, deform, deformView: deformView(deform), kernels: new Map(), shell: null,
+      // The bodies the next pre-pass runs (list, its CPU copy `listed`), and which bodies' rows changed
+      // since their last pre-pass (`moved`): a body whose pose stood still is not deformed again.
+      list, listed: list.value.array, moved: new Uint8Array(size),
       alive: new Uint8Array(size), seed: new Uint32Array(size), spawnTick: new Float64Array(size),
       motions: new Array(size).fill(null), bounds: new Float64Array(6 * size),
       genomes: new Float64Array(GENOME_LENGTH * size), colours: new Float64Array(3 * data.slotCount * size),
@@ -54,7 +58,7 @@ function kernelFor(state, page, kind) {
     const { layout, programs, records, vertices } = state;
     const fns = bodyFunctions(layout, page.pose, programs);
     page.kernels.set(kind, createDeformKernel(layout, fns, {
-      pose: page.pose, records, deform: page.deform, size: page.size, vertices, skinOnly: kind === 'skin-only',
+      pose: page.pose, records, deform: page.deform, list: page.list, size: page.size, vertices, skinOnly: kind === 'skin-only',
     }));
   }
   return page.kernels.get(kind);

@@ -21,7 +21,7 @@ import { DEFORM_STRIDE, dispatchDeform, vertexRecords } from './deform.js';
 import { registerInternals } from './internals.js';
 import { checkDebugMode } from './material.js';
 import { createPages, kernelKind, showMode } from './pages.js';
-import { advance, deformRange, flush, locate, writeCurrent, writeInstance } from './staging.js';
+import { advance, deformAll, flush, locate, writeCurrent, writeInstance } from './staging.js';
 
 const SHIPPED_VARIANTS = ['off'];
 
@@ -115,11 +115,15 @@ export async function createCreaturePopulation(renderer, options = {}) {
     variants: new Map(),
     stats: {
       uploads: 0, uploadBytes: 0, lastFrameBytes: 0, spawns: 0, ticks: 0, deformDispatches: 0, lastFrameDeformedVertices: 0,
+      lastFrameDeformedBodies: 0,
     },
     pages: null,
     rootRow: data.slotCount * POSE_ROWS * 4,
     // Scratch for writing rows and bounds, reused by every body every frame.
-    scratch: { tmp: new Float64Array(3), localBox: new Float64Array(6), corner: new THREE.Vector3(), box: new THREE.Box3() },
+    scratch: {
+      tmp: new Float64Array(3), localBox: new Float64Array(6), corner: new THREE.Vector3(), box: new THREE.Box3(),
+      previous: new Float32Array(floatsPerInstance),
+    },
     tick: 0,
     mode: checkDebugMode(options.debugMode ?? 'off'),
   };
@@ -183,6 +187,7 @@ export async function createCreaturePopulation(renderer, options = {}) {
       page.genomes.fill(0, GENOME_LENGTH * j, GENOME_LENGTH * (j + 1));
       page.colours.fill(0, 3 * data.slotCount * j, 3 * data.slotCount * (j + 1));
       page.staging.fill(0, j * floatsPerInstance, (j + 1) * floatsPerInstance);
+      page.moved[j] = 0;
       page.dirtyLo = Math.min(page.dirtyLo, j);
       page.dirtyHi = Math.max(page.dirtyHi, j);
     },
@@ -253,7 +258,7 @@ export async function createCreaturePopulation(renderer, options = {}) {
       const rerun = kernelKind(m) !== kernelKind(state.mode);
       for (const page of pages) {
         showMode(state, page, m);
-        if (rerun) deformRange(state, page, 0, page.size - 1);
+        if (rerun) deformAll(state, page);
       }
       state.mode = m;
     },
@@ -270,11 +275,13 @@ export async function createCreaturePopulation(renderer, options = {}) {
       for (const m of SHIPPED_VARIANTS) {
         for (const page of pages) {
           showMode(state, page, m);
-          dispatchDeform(renderer, page.kernel, 0, 0);
+          dispatchDeform(renderer, page.kernel, 1);
         }
         await renderer.compileAsync(scene, camera);
       }
       pages.forEach((p, i) => { p.mesh.count = saved[i]; showMode(state, p, state.mode); });
+      // Each variant's warm-up dispatch wrote its own surface for a listed body: the shown one redraws them.
+      for (const page of pages) deformAll(state, page);
     },
     dispose() {
       geometry.dispose();

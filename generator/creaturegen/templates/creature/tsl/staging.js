@@ -1,6 +1,8 @@
 // A population's CPU side of the pose pages: each body's rows written into its page's staging copy, the
-// page's posed bounds, and the flush that uploads one coalesced dirty range per page and runs the deform
-// pre-pass over exactly that range. All in place: the steady frame loop allocates nothing.
+// page's posed bounds, and the flush that uploads one coalesced range of changed rows per page and runs the
+// deform pre-pass over exactly the bodies whose rows changed since their last pre-pass (a body standing
+// still, e.g. a hopper between hops or a frame with no step and the same interpolation, keeps its stored
+// surface). All in place: the steady frame loop allocates nothing.
 import { rootBounds, writePoseRows, writeRootRows } from '../core/pose.js';
 import { dispatchDeform } from './deform.js';
 
@@ -14,15 +16,23 @@ export function locate(state, id) {
 
 /**
  * One body's rows from per-slot transforms and a root (the motion's current step, or its render pose),
- * and its world bounds; marks the instance dirty for the next flush.
+ * and its world bounds. When any row differs from what the staging copy held, the body is marked moved
+ * (its next pre-pass re-deforms it) and its rows join the page's upload range.
  */
 export function writeInstance(state, page, j, quats, trans, root) {
   const { data, floatsPerInstance, rootRow, scratch } = state;
   const base = j * floatsPerInstance;
   const size = page.motions[j].size;
-  writePoseRows(data, quats, trans, page.colours, 3 * data.slotCount * j, scratch.tmp, page.staging, base, scratch.localBox, size);
-  writeRootRows(root, page.alive[j], page.staging, base + rootRow, size);
+  const rows = page.staging;
+  const previous = scratch.previous;
+  for (let i = 0; i < floatsPerInstance; i++) previous[i] = rows[base + i];
+  writePoseRows(data, quats, trans, page.colours, 3 * data.slotCount * j, scratch.tmp, rows, base, scratch.localBox, size);
+  writeRootRows(root, page.alive[j], rows, base + rootRow, size);
   rootBounds(scratch.localBox, root, page.bounds, 6 * j);
+  let changed = false;
+  for (let i = 0; i < floatsPerInstance && !changed; i++) changed = rows[base + i] !== previous[i];
+  if (!changed) return;
+  page.moved[j] = 1;
   page.dirtyLo = Math.min(page.dirtyLo, j);
   page.dirtyHi = Math.max(page.dirtyHi, j);
 }
@@ -64,22 +74,42 @@ function refreshBounds(state, page) {
   else box.getBoundingSphere(page.mesh.boundingSphere);
 }
 
-/** The pre-pass over instances lo..hi of a page, clipped to the drawn range (dead ones are skipped). */
-export function deformRange(state, page, lo, hi) {
-  const top = Math.min(hi, page.mesh.count - 1);
-  if (top < lo) return 0;
+/**
+ * The pre-pass over the page's moved live bodies in its drawn range: their indices written into the
+ * page's instance list (uploaded with the dispatch), one dispatch; every moved flag cleared. Returns the
+ * vertices processed.
+ */
+export function deformMoved(state, page) {
+  const top = page.mesh.count;
+  let n = 0;
+  for (let j = 0; j < top; j++) {
+    if (page.moved[j] && page.alive[j]) page.listed[n++] = j;
+  }
+  page.moved.fill(0);
+  state.stats.lastFrameDeformedBodies += n;
+  if (n === 0) return 0;
+  page.list.value.addUpdateRange(0, n);
+  page.list.value.needsUpdate = true;
   state.stats.deformDispatches += 1;
-  return dispatchDeform(state.renderer, page.kernel, lo, top);
+  return dispatchDeform(state.renderer, page.kernel, n);
+}
+
+/** Re-deform every live body of the page (a new pre-pass kernel: debug mode 'skin-only' and back). */
+export function deformAll(state, page) {
+  page.moved.fill(1);
+  return deformMoved(state, page);
 }
 
 /**
- * One coalesced range per page: [first dirty instance, last dirty instance], uploaded once per flush,
- * then that range deformed once (the upload rides on the dispatch's binding update). Returns the bytes.
+ * One coalesced range per page: [first changed instance, last changed instance], uploaded once per
+ * flush, then the moved bodies deformed once (the upload rides on the dispatch's binding update).
+ * Returns the bytes.
  */
 export function flush(state) {
   const { floatsPerInstance, stats } = state;
   let bytes = 0;
   let deformed = 0;
+  stats.lastFrameDeformedBodies = 0;
   for (const page of state.pages) {
     if (page.dirtyHi < 0) continue;
     const start = page.dirtyLo * floatsPerInstance;
@@ -88,7 +118,7 @@ export function flush(state) {
     page.pose.value.needsUpdate = true;
     bytes += 4 * count;
     refreshBounds(state, page);
-    deformed += deformRange(state, page, page.dirtyLo, page.dirtyHi);
+    deformed += deformMoved(state, page);
     page.dirtyLo = Infinity;
     page.dirtyHi = -1;
   }
