@@ -417,6 +417,39 @@ def test_the_job_catches_a_pre_pass_that_ignores_what_moved(
 
 
 @pytest.mark.browser
+@pytest.mark.parametrize(
+    ("planted_defect", "swap", "gates"),
+    [
+        (
+            "culled bodies drawn and deformed anyway",
+            ("if (!seen(state, page, j)) { culled++; continue; }", "if (!seen(state, page, j)) culled++;"),
+            {"bodies drawn in body 0's portrait view of 10 spread 4.0 L apart (rest culled)"},
+        ),
+        (
+            "a pre-pass that forgets the bodies that moved while culled",
+            (
+                "  state.stats.lastFrameDeformedBodies += n;\n",
+                "  page.moved.fill(0);\n  state.stats.lastFrameDeformedBodies += n;\n",
+            ),
+            {
+                "bodies deformed when culling stops vs the bodies culled while they moved",
+                "pixels of the population after culling vs every body deformed afresh",
+            },
+        ),
+    ],
+)
+def test_the_job_catches_wrong_culling(
+    out_root: Path, tmp_path: Path, planted_defect: str, swap: tuple[str, str], gates: set[str]
+) -> None:
+    """Culling by posed bounds (cullWith): a cull that keeps drawing what it culls, and one that loses the
+    bodies that moved while culled (they come back with a stale surface), each fail their gates."""
+    package = build("reference/hopper.json", out_root)
+    report = run_creature_parity(_planted(package, tmp_path, "staging.js", [swap]), groups=("cull",))
+    failed, summary = {g["name"] for g in report.gates if g["status"] == "fail"}, report.summary()
+    assert gates <= failed, (planted_defect, summary)
+
+
+@pytest.mark.browser
 def test_the_job_catches_a_page_drawn_twice_in_a_pass(out_root: Path, tmp_path: Path) -> None:
     """A second mesh per page over the same geometry and material (an outline proxy, say) keeps the pages
     in use right but draws each page twice in the display pass: the draws-beyond-pages gate fails, and
@@ -432,8 +465,8 @@ def test_the_job_catches_a_page_drawn_twice_in_a_pass(out_root: Path, tmp_path: 
         "  page.twin.material = page.mesh.material;\n",
     )
     count = (
-        "  page.mesh.count = last + 1;\n",
-        "  page.mesh.count = last + 1;\n  if (page.twin) page.twin.count = page.mesh.count;\n",
+        "  page.mesh.count = n;\n",
+        "  page.mesh.count = n;\n  if (page.twin) page.twin.count = page.mesh.count;\n",
     )
     package = build("reference/hopper.json", out_root)
     planted = _planted_files(package, tmp_path, {"pages.js": [twin], "staging.js": [count]})

@@ -40,13 +40,21 @@ from pathlib import Path
 
 from ..creature import reference as cref
 from .creature_lab import DEFAULT_CANVAS, LAB_POSITION, LAB_SEED, PARITY_TICK, open_creature_lab_page
-from .creature_population import GRID_SIDE, PAGE_SIZE, PAGES_IN_BURST, SPARE_PAGES, counter_gates, grid_gates
+from .creature_population import (
+    GRID_SIDE,
+    PAGE_SIZE,
+    PAGES_IN_BURST,
+    SPARE_PAGES,
+    counter_gates,
+    cull_gates,
+    grid_gates,
+)
 from .creature_pose import hash_gate, motion_gates, pose_and_field_gates
 from .creature_skin import skin_gates
 from .creature_views import pictures, shadow_gate
 from .report import ParityReport, adapter_gate, console_problems
 
-GATE_GROUPS = ("population", "hash", "field", "motion", "skin", "shadow", "grid")
+GATE_GROUPS = ("population", "hash", "field", "motion", "skin", "shadow", "cull", "grid")
 
 
 def run_creature_parity(
@@ -89,6 +97,8 @@ def run_creature_parity(
         t = time.perf_counter()
         pictures(page, package, debug_pictures, report)
         seconds["pictures"] = time.perf_counter() - t
+        # After the pictures: culling spreads bodies around body 0 and takes them away again.
+        phase("cull", lambda: cull_gates(page, report))
         # Last: the grid replaces every body (instance 0 included) of the lab.
         phase("grid", lambda: grid_gates(page, ref, package, report))
         page.evaluate("() => window.__lab.finish()")

@@ -38,6 +38,10 @@ GRID_SIDE = 8
 GRID_SEED = 0
 GRID_SPACING = 2.0
 GRID_TICK = 24
+#: The culling layout: bodies spawned around body 0 on a grid this many body lengths apart, so that body
+#: 0's portrait view sees some and misses the rest.
+CULL_BODIES = 9
+CULL_SPACING = 4.0
 #: Genome colours in the GPU rows vs Python: both round the same float64 value to float32, so exactly 0.
 COLOUR_TOL = 0.0
 
@@ -114,6 +118,56 @@ def counter_gates(page: Page, report: ParityReport) -> None:
         "spawnCost": page.evaluate("() => window.__lab.spawnCost()"),
         "sinceReveal": after,
     }
+    page.evaluate("() => window.__lab.despawnAll([0])")
+
+
+def cull_gates(page: Page, report: ParityReport) -> None:
+    """Culling by posed bounds (population.cullWith): bodies spread far beyond body 0's portrait view,
+    culled to that view for a tick: only the bodies it sees are drawn and deformed; when culling stops, the
+    bodies that moved while culled are deformed before they are drawn, and the whole population's picture
+    equals the one of every body deformed afresh."""
+    page.evaluate("() => window.__lab.despawnAll([0])")
+    page.evaluate(f"() => window.__lab.spawn(3000, {CULL_BODIES}, {CULL_SPACING}, true)")
+    page.evaluate("() => window.__lab.cullWith('portrait')")
+    page.evaluate("() => window.__lab.stepTicks(1)")
+    telemetry = page.evaluate("() => window.__lab.telemetry()")
+    culled, live = telemetry["stats"], int(telemetry["count"])
+    report.gate(
+        f"bodies drawn in body 0's portrait view of {live} spread {CULL_SPACING} L apart (rest culled)",
+        float(culled["lastFrameDrawnBodies"]),
+        float(live),
+        "bodies",
+        passed=culled["lastFrameDrawnBodies"] + culled["lastFrameCulledBodies"] == live
+        and 0 < culled["lastFrameCulledBodies"] < live,
+    )
+    report.gate(
+        "bodies deformed by a culled tick beyond the bodies drawn (only what is seen)",
+        abs(culled["lastFrameDeformedBodies"] - culled["lastFrameDrawnBodies"]),
+        0,
+        "bodies",
+    )
+    # No pose changes from here: the one flush after culling stops deforms exactly the bodies that moved
+    # while they were culled.
+    page.evaluate("() => window.__lab.cullWith('none')")
+    page.evaluate("() => window.__lab.redraw()")
+    back = page.evaluate("() => window.__lab.telemetry()")["stats"]
+    report.gate(
+        "bodies deformed when culling stops vs the bodies culled while they moved",
+        abs(int(culled["lastFrameCulledBodies"]) - int(back["lastFrameDeformedBodies"])),
+        0,
+        "bodies",
+    )
+    returned = rgba_image(page.evaluate("() => window.__lab.capturePixels('grid')"))
+    page.evaluate("() => window.__lab.setDebugMode('skin-only')")
+    page.evaluate("() => window.__lab.setDebugMode('off')")
+    fresh = rgba_image(page.evaluate("() => window.__lab.capturePixels('grid')"))
+    differing = int(np.count_nonzero(np.any(returned != fresh, axis=2)))
+    report.gate(
+        "pixels of the population after culling vs every body deformed afresh",
+        differing,
+        0,
+        "pixels",
+    )
     page.evaluate("() => window.__lab.despawnAll([0])")
 
 

@@ -333,6 +333,15 @@ async function main() {
       };
     },
     setTier(t) { pop.setTier(t); return t; },
+    /** Flush (whatever changed since the last upload, culling included) and draw one frame. */
+    redraw() { const bytes = pop.flush(); render(); return bytes; },
+    /** Cull against body 0's portrait view as it stands now ('portrait'), the lab camera ('camera'), or nothing. */
+    cullWith(which = 'none') {
+      const views = { portrait: () => [portraitCamera()], camera: () => [camera], none: () => [] }[which];
+      if (!views) throw new Error(`cullWith: portrait, camera or none (got ${which})`);
+      pop.cullWith(...views());
+      return which;
+    },
     setDebugMode(m) { pop.setDebugMode(m); render(); return m; },
     spawn(seed, count = 1, spacing = 1.5, draw = true) {
       const ids = [];

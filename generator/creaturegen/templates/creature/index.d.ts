@@ -1,6 +1,6 @@
 // Types of the package entry: the pure-JS core (`./core`) and the population API of the three/TSL adapter
 // (also exported by `./tsl`). The three.js types come from @types/three, an optional peer dependency.
-import type { Camera, Group, Mesh, Object3D, WebGPURenderer } from 'three/webgpu';
+import type { Camera, Group, Light, Mesh, Object3D, WebGPURenderer } from 'three/webgpu';
 import type {
   DebugMode, Driver, GravityProvider, Motion, SupportSurfaceProvider, TierName, WaterSurfaceProvider,
 } from './core/index.js';
@@ -68,6 +68,8 @@ export interface CreaturePopulation {
     deformDispatches: number; lastFrameDeformedVertices: number;
     /** Bodies the last flush re-deformed: those whose pose rows changed since their last pre-pass. */
     lastFrameDeformedBodies: number;
+    /** Live bodies the last flush left drawn, and those it culled (cullWith). */
+    lastFrameDrawnBodies: number; lastFrameCulledBodies: number;
   };
   /** One pose page: its body mesh (one draw per pass) and, once debug mode 'shell' was shown, its shell. */
   readonly pages: { mesh: Mesh; shell: Mesh | null }[];
@@ -92,6 +94,11 @@ export interface CreaturePopulation {
   instance(id: number): InstanceInfo;
   stateHash(): string;
   setDebugMode(mode: DebugMode): void;
+  /**
+   * Cull bodies by their posed bounds against these cameras or shadow-casting lights at every flush: only
+   * bodies one of them sees are deformed and drawn. No arguments: no culling (the default).
+   */
+  cullWith(...views: Array<Camera | Light>): void;
   setTier(tier: TierName): void;
   /** Build every shipped variant (deform compute, display, shadow) before the first visible frame. */
   warm(scene: Object3D, camera: Camera): Promise<void>;

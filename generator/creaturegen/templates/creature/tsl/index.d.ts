@@ -85,11 +85,11 @@ export function dispatchDeform(renderer: WebGPURenderer, deform: DeformKernel, c
 
 /** Throws unless `mode` is one of DEBUG_MODES; returns it. */
 export function checkDebugMode(mode: string): DebugMode;
-export function createBodyMaterial(layout: Layout, pose: PoseStorage, deform: PoseStorage, mode: DebugMode): MeshStandardNodeMaterial;
+export function createBodyMaterial(layout: Layout, pose: PoseStorage, deform: PoseStorage, drawList: PoseStorage, mode: DebugMode): MeshStandardNodeMaterial;
 export function rootRotate(root1: Node, v: Node): Node;
 export function rootPoint(root1: Node, p: Node): Node;
 export function rootNormal(root1: Node, n: Node): Node;
-export function createShellMesh(layout: Layout, pose: PoseStorage, name: string): Mesh;
+export function createShellMesh(layout: Layout, pose: PoseStorage, drawList: PoseStorage, name: string): Mesh;
 
 /** Throws unless `renderer` is an initialised WebGPURenderer on the WebGPU backend. */
 export function assertWebGPU(renderer: WebGPURenderer): void;

@@ -1,4 +1,5 @@
-// The body material of one pose page. The vertex stage only reads: the deformed vertex the page's deform
+// The body material of one pose page. Instance i of the draw is body drawList[i] of the page (the live bodies
+// the population did not cull, staging.js). The vertex stage only reads: the deformed vertex the page's deform
 // pre-pass stored (deform.js: skinned, corrected, the analytic field gradient and the albedo), then the
 // root transform (squash, yaw, position), applied once here (a plain Mesh with `count` instances: no
 // instanceMatrix, so nothing is applied twice); the normal takes the transform's inverse transpose and goes
@@ -42,14 +43,14 @@ export const rootNormal = (root1, n) => {
 
 /**
  * The display material of a page for one debug mode (a variant; cached by the population). `deform` is
- * the page's read-only deformed-vertex view (deform.js deformView); 'skin-only' is the same material over
- * the skin-only pre-pass.
+ * the page's read-only deformed-vertex view (deform.js deformView), `drawList` the page's list of drawn
+ * bodies (instance i draws body drawList[i]); 'skin-only' is the same material over the skin-only pre-pass.
  */
-export function createBodyMaterial(layout, pose, deform, mode) {
+export function createBodyMaterial(layout, pose, deform, drawList, mode) {
   const material = new THREE.MeshStandardNodeMaterial({ roughness: 0.55, metalness: 0.0 });
   const vColour = varyingProperty('vec3', 'vCgColour');
   material.positionNode = Fn(() => {
-    const j = int(instanceIndex);
+    const j = drawList.element(int(instanceIndex)).toVar();
     const rootRow = j.mul(layout.maxParts * layout.rows).add(layout.slotCount * layout.rows);
     const root0 = pose.element(rootRow).toVar();
     const root1 = pose.element(rootRow.add(1)).toVar();

@@ -26,11 +26,15 @@ export function createPages(state) {
     group.add(mesh);
     const deform = deformStorage(size, vertices);
     const list = instanceList(size);
+    const drawList = instanceList(size);
     pages.push({
       first, size, pose, mesh, staging: pose.value.array, deform, deformView: deformView(deform), kernels: new Map(), shell: null,
       // The bodies the next pre-pass runs (list, its CPU copy `listed`), and which bodies' rows changed
       // since their last pre-pass (`moved`): a body whose pose stood still is not deformed again.
       list, listed: list.value.array, moved: new Uint8Array(size),
+      // The bodies the passes draw (drawList, its CPU copy `drawn`: live and, when the population culls,
+      // seen by one of its views), in instance order; mesh.count is how many.
+      drawList, drawn: drawList.value.array, culled: 0,
       alive: new Uint8Array(size), seed: new Uint32Array(size), spawnTick: new Float64Array(size),
       motions: new Array(size).fill(null), bounds: new Float64Array(6 * size),
       genomes: new Float64Array(GENOME_LENGTH * size), colours: new Float64Array(3 * data.slotCount * size),
@@ -49,7 +53,7 @@ function materialFor(state, page, m) {
   const shown = m === 'shell' ? 'off' : m;
   const key = `${[data.signatures.compilerSignature, data.signatures.topologySignature, data.tier, shown, data.registers].join('|')}`
     + `|page${pages.indexOf(page)}`;
-  if (!variants.has(key)) variants.set(key, createBodyMaterial(layout, page.pose, page.deformView, shown));
+  if (!variants.has(key)) variants.set(key, createBodyMaterial(layout, page.pose, page.deformView, page.drawList, shown));
   return variants.get(key);
 }
 
@@ -70,7 +74,7 @@ export function showMode(state, page, m) {
   page.mesh.material = materialFor(state, page, m);
   page.kernel = kernelFor(state, page, kernelKind(m));
   if (m === 'shell' && !page.shell) {
-    page.shell = createShellMesh(layout, page.pose, page.mesh.name);
+    page.shell = createShellMesh(layout, page.pose, page.drawList, page.mesh.name);
     page.shell.boundingSphere = page.mesh.boundingSphere;
     group.add(page.shell);
   }

@@ -115,15 +115,17 @@ export async function createCreaturePopulation(renderer, options = {}) {
     variants: new Map(),
     stats: {
       uploads: 0, uploadBytes: 0, lastFrameBytes: 0, spawns: 0, ticks: 0, deformDispatches: 0, lastFrameDeformedVertices: 0,
-      lastFrameDeformedBodies: 0,
+      lastFrameDeformedBodies: 0, lastFrameDrawnBodies: 0, lastFrameCulledBodies: 0,
     },
     pages: null,
     rootRow: data.slotCount * POSE_ROWS * 4,
     // Scratch for writing rows and bounds, reused by every body every frame.
     scratch: {
       tmp: new Float64Array(3), localBox: new Float64Array(6), corner: new THREE.Vector3(), box: new THREE.Box3(),
-      previous: new Float32Array(floatsPerInstance),
+      previous: new Float32Array(floatsPerInstance), bodyBox: new THREE.Box3(), matrix: new THREE.Matrix4(),
     },
+    // The views the population culls against (cullWith) and their frusta, refreshed at every flush.
+    views: [], frusta: [], viewsChanged: false,
     tick: 0,
     mode: checkDebugMode(options.debugMode ?? 'off'),
   };
@@ -261,6 +263,22 @@ export async function createCreaturePopulation(renderer, options = {}) {
         if (rerun) deformAll(state, page);
       }
       state.mode = m;
+    },
+    /**
+     * Cull bodies by their posed bounds against `views`: cameras, or shadow-casting lights (their shadow
+     * cameras). From the next flush on, only the live bodies one of the views sees are deformed and drawn,
+     * in every pass (a body that casts a shadow into the picture is seen by the light's view); a body that
+     * moved while culled is deformed when it comes back into view. No views (the default): no culling.
+     * Creates no GPU object (the draw lists exist per page).
+     */
+    cullWith(...views) {
+      for (const view of views) {
+        const usable = view?.isCamera === true || (view?.isLight === true && view.shadow?.camera?.isCamera === true);
+        if (!usable) throw new Error(`cullWith: cameras or shadow-casting lights (got ${view?.type ?? view})`);
+      }
+      state.views = views;
+      state.frusta = views.map(() => new THREE.Frustum());
+      state.viewsChanged = true;
     },
     setTier(t) {
       if (t !== data.tier) throw new Error(`tier: this package was built for tier ${data.tier} (got ${t}); rebuild with --tier ${t}`);

@@ -19,14 +19,16 @@ function shellGeometry() {
   return geometry;
 }
 
-/** The shell mesh of one page (drawn in place of the body while the debug mode is 'shell'). */
-export function createShellMesh(layout, pose, name) {
+/** The shell mesh of one page (drawn in place of the body while the debug mode is 'shell'): instance i is
+ * slot i % slotCount of body drawList[i / slotCount]. */
+export function createShellMesh(layout, pose, drawList, name) {
   const material = new THREE.MeshStandardNodeMaterial({ roughness: 0.7, metalness: 0.0 });
   const vColour = varyingProperty('vec3', 'vCgShellColour');
   material.positionNode = Fn(() => {
     const i = int(instanceIndex);
-    const j = i.div(layout.slotCount);
-    const s = i.sub(j.mul(layout.slotCount));
+    const k = i.div(layout.slotCount);
+    const s = i.sub(k.mul(layout.slotCount));
+    const j = drawList.element(k).toVar();
     const base = j.mul(layout.maxParts * layout.rows).toVar();
     const o = base.add(s.mul(layout.rows)).toVar();
     const rowA = pose.element(o).toVar();

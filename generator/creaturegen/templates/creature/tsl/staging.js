@@ -1,8 +1,9 @@
 // A population's CPU side of the pose pages: each body's rows written into its page's staging copy, the
-// page's posed bounds, and the flush that uploads one coalesced range of changed rows per page and runs the
-// deform pre-pass over exactly the bodies whose rows changed since their last pre-pass (a body standing
-// still, e.g. a hopper between hops or a frame with no step and the same interpolation, keeps its stored
-// surface). All in place: the steady frame loop allocates nothing.
+// page's posed bounds, and the flush that uploads one coalesced range of changed rows per page, culls the
+// page's bodies against the population's views (when it has any) and runs the deform pre-pass over exactly
+// the drawn bodies whose rows changed since their last pre-pass (a body standing still, e.g. a hopper
+// between hops or a frame with no step and the same interpolation, keeps its stored surface; a culled
+// body is neither deformed nor drawn). All in place: the steady frame loop allocates nothing.
 import { rootBounds, writePoseRows, writeRootRows } from '../core/pose.js';
 import { dispatchDeform } from './deform.js';
 
@@ -56,36 +57,86 @@ export function advance(state, n) {
   state.stats.ticks += n;
 }
 
-// The page's drawn count (up to its last live body) and bounding sphere over its live bodies' bounds.
-function refreshBounds(state, page) {
+/**
+ * The population's culling views for this flush: each camera's frustum (a shadow-casting light's shadow
+ * camera, its matrices brought up to date first) and the group's world matrix, so that bounds in
+ * population space can be tested in world space. Nothing is allocated (the frusta exist per view).
+ */
+export function updateViews(state) {
+  const { views, frusta, scratch } = state;
+  state.group.updateWorldMatrix(true, false);
+  for (let i = 0; i < views.length; i++) {
+    let camera = views[i];
+    if (camera.isLight) {
+      camera.updateMatrixWorld();
+      camera.target?.updateMatrixWorld();
+      camera.shadow.updateMatrices(camera);
+      camera = camera.shadow.camera;
+    } else {
+      camera.updateMatrixWorld();
+    }
+    scratch.matrix.multiplyMatrices(camera.projectionMatrix, camera.matrixWorldInverse);
+    frusta[i].setFromProjectionMatrix(scratch.matrix, camera.coordinateSystem, camera.reversedDepth);
+  }
+}
+
+// Whether body j's posed bounds meet one of the views (without views every body is seen).
+function seen(state, page, j) {
+  const { frusta, scratch } = state;
+  if (frusta.length === 0) return true;
+  const b = page.bounds;
+  const box = scratch.bodyBox;
+  box.min.set(b[6 * j], b[6 * j + 1], b[6 * j + 2]);
+  box.max.set(b[6 * j + 3], b[6 * j + 4], b[6 * j + 5]);
+  box.applyMatrix4(state.group.matrixWorld);
+  for (let i = 0; i < frusta.length; i++) if (frusta[i].intersectsBox(box)) return true;
+  return false;
+}
+
+/**
+ * The page's drawn bodies: its live bodies that a view sees (every live body when the population does not
+ * cull), in instance order, into its draw list (uploaded when it changed); the mesh draws that many
+ * instances, and its bounding sphere covers them (three's own per-page culling).
+ */
+export function refreshDrawn(state, page) {
   const { box, corner } = state.scratch;
   box.makeEmpty();
-  let last = -1;
+  let n = 0;
+  let culled = 0;
+  let changed = false;
+  const b = page.bounds;
   for (let j = 0; j < page.size; j++) {
     if (!page.alive[j]) continue;
-    last = j;
-    const b = page.bounds;
+    if (!seen(state, page, j)) { culled++; continue; }
+    if (page.drawn[n] !== j) { page.drawn[n] = j; changed = true; }
+    n++;
     box.expandByPoint(corner.set(b[6 * j], b[6 * j + 1], b[6 * j + 2]));
     box.expandByPoint(corner.set(b[6 * j + 3], b[6 * j + 4], b[6 * j + 5]));
   }
-  page.mesh.count = last + 1;
+  if (changed) {
+    page.drawList.value.addUpdateRange(0, n);
+    page.drawList.value.needsUpdate = true;
+  }
+  page.culled = culled;
+  page.mesh.count = n;
   if (page.shell) page.shell.count = page.mesh.count * state.data.slotCount;
-  if (last < 0) page.mesh.boundingSphere.set(page.mesh.boundingSphere.center.set(0, 0, 0), 0);
+  if (n === 0) page.mesh.boundingSphere.set(page.mesh.boundingSphere.center.set(0, 0, 0), 0);
   else box.getBoundingSphere(page.mesh.boundingSphere);
 }
 
 /**
- * The pre-pass over the page's moved live bodies in its drawn range: their indices written into the
- * page's instance list (uploaded with the dispatch), one dispatch; every moved flag cleared. Returns the
- * vertices processed.
+ * The pre-pass over the page's drawn bodies that moved since their last pre-pass: their indices written
+ * into the page's instance list (uploaded with the dispatch), one dispatch. A moved body that is culled
+ * keeps its flag and is deformed when a view sees it again. Returns the vertices processed.
  */
 export function deformMoved(state, page) {
-  const top = page.mesh.count;
   let n = 0;
-  for (let j = 0; j < top; j++) {
-    if (page.moved[j] && page.alive[j]) page.listed[n++] = j;
+  for (let i = 0; i < page.mesh.count; i++) {
+    const j = page.drawn[i];
+    if (!page.moved[j]) continue;
+    page.moved[j] = 0;
+    page.listed[n++] = j;
   }
-  page.moved.fill(0);
   state.stats.lastFrameDeformedBodies += n;
   if (n === 0) return 0;
   page.list.value.addUpdateRange(0, n);
@@ -96,33 +147,45 @@ export function deformMoved(state, page) {
 
 /** Re-deform every live body of the page (a new pre-pass kernel: debug mode 'skin-only' and back). */
 export function deformAll(state, page) {
-  page.moved.fill(1);
+  for (let j = 0; j < page.size; j++) page.moved[j] = page.alive[j];
   return deformMoved(state, page);
 }
 
 /**
  * One coalesced range per page: [first changed instance, last changed instance], uploaded once per
- * flush, then the moved bodies deformed once (the upload rides on the dispatch's binding update).
+ * flush; the page's drawn bodies refreshed (every flush when the population culls: the views move); then
+ * the drawn bodies that moved deformed once (the uploads ride on the dispatch's binding update).
  * Returns the bytes.
  */
 export function flush(state) {
   const { floatsPerInstance, stats } = state;
+  const culling = state.views.length > 0;
+  if (culling) updateViews(state);
   let bytes = 0;
   let deformed = 0;
+  let drawn = 0;
+  let culled = 0;
   stats.lastFrameDeformedBodies = 0;
   for (const page of state.pages) {
-    if (page.dirtyHi < 0) continue;
-    const start = page.dirtyLo * floatsPerInstance;
-    const count = (page.dirtyHi - page.dirtyLo + 1) * floatsPerInstance;
-    page.pose.value.addUpdateRange(start, count);
-    page.pose.value.needsUpdate = true;
-    bytes += 4 * count;
-    refreshBounds(state, page);
+    const dirty = page.dirtyHi >= 0;
+    if (dirty) {
+      const start = page.dirtyLo * floatsPerInstance;
+      const count = (page.dirtyHi - page.dirtyLo + 1) * floatsPerInstance;
+      page.pose.value.addUpdateRange(start, count);
+      page.pose.value.needsUpdate = true;
+      bytes += 4 * count;
+    }
+    if (dirty || culling || state.viewsChanged) refreshDrawn(state, page);
     deformed += deformMoved(state, page);
+    drawn += page.mesh.count;
+    culled += page.culled;
     page.dirtyLo = Infinity;
     page.dirtyHi = -1;
   }
+  state.viewsChanged = false;
   stats.lastFrameDeformedVertices = deformed;
+  stats.lastFrameDrawnBodies = drawn;
+  stats.lastFrameCulledBodies = culled;
   stats.lastFrameBytes = bytes;
   stats.uploadBytes += bytes;
   if (bytes) stats.uploads += 1;
