@@ -379,6 +379,7 @@ def test_the_job_catches_a_spawn_that_spreads_bodies_over_pages(out_root: Path, 
 
 MOVED_GATE = "bodies deformed by a tick that moves every live body (pre-pass: all of them)"
 STILL_GATE = "bodies deformed by a frame in which no pose changed (pre-pass: only what moved)"
+PAUSE_GATE = "bodies deformed by a tick with one body paused, beyond the live bodies but that one"
 SPAWN_GATE = "bodies deformed by a frame whose only change is one spawn beside still bodies (only what moved)"
 
 
@@ -387,11 +388,8 @@ SPAWN_GATE = "bodies deformed by a frame whose only change is one spawn beside s
     ("planted_defect", "swap", "gate", "quiet"),
     [
         (
-            "a pre-pass over every live body, moved or not",
-            (
-                "if (page.moved[j] && page.alive[j]) page.listed[n++] = j;",
-                "if (page.alive[j]) page.listed[n++] = j;",
-            ),
+            "a pre-pass over every drawn body, moved or not",
+            ("    if (!page.moved[j]) continue;\n", ""),
             SPAWN_GATE,
             MOVED_GATE,
         ),
@@ -417,6 +415,32 @@ def test_the_job_catches_a_pre_pass_that_ignores_what_moved(
 
 
 @pytest.mark.browser
+def test_the_job_catches_a_population_that_steps_paused_bodies(out_root: Path, tmp_path: Path) -> None:
+    """pause(id) holds a body still: a population that steps and rewrites it anyway re-deforms it, and the
+    paused-body gate (bodies deformed by the tick, the paused body's staged rows) fails."""
+    package = build("reference/hopper.json", out_root)
+    planted = _planted_files(
+        package,
+        tmp_path,
+        {
+            "staging.js": [
+                ("if (!page.alive[j] || page.paused[j]) continue;", "if (!page.alive[j]) continue;")
+            ],
+            "population.js": [
+                (
+                    "if (page.alive[j] && !page.paused[j]) writeCurrent(state, page, j);",
+                    "if (page.alive[j]) writeCurrent(state, page, j);",
+                )
+            ],
+        },
+    )
+    report = run_creature_parity(planted, groups=("population",))
+    failed, summary = {g["name"] for g in report.gates if g["status"] == "fail"}, report.summary()
+    assert PAUSE_GATE in failed, summary
+    assert STILL_GATE not in failed, summary
+
+
+@pytest.mark.browser
 @pytest.mark.parametrize(
     ("planted_defect", "swap", "gates"),
     [
@@ -433,7 +457,7 @@ def test_the_job_catches_a_pre_pass_that_ignores_what_moved(
             ),
             {
                 "bodies deformed when culling stops vs the bodies culled while they moved",
-                "pixels of the population after culling vs every body deformed afresh",
+                "drawn vertices of 10 bodies after culling vs every body deformed afresh (bytes)",
             },
         ),
     ],

@@ -333,6 +333,9 @@ async function main() {
       };
     },
     setTier(t) { pop.setTier(t); return t; },
+    /** Hold these instances still (population.pause), or step them on again. */
+    pause(ids = [0]) { for (const id of ids) pop.pause(id); return ids; },
+    resume(ids = [0]) { for (const id of ids) pop.resume(id); return ids; },
     /** Flush (whatever changed since the last upload, culling included) and draw one frame. */
     redraw() { const bytes = pop.flush(); render(); return bytes; },
     /** Cull against body 0's portrait view as it stands now ('portrait'), the lab camera ('camera'), or nothing. */

@@ -39,6 +39,8 @@ export interface SpawnOptions {
 
 export interface InstanceInfo {
   alive: boolean;
+  /** Held still by pause(): not stepped, not re-deformed, still drawn. */
+  paused: boolean;
   seed: number;
   /** Population tick at spawn: the body's own tick is the population's minus this. */
   spawnTick: number;
@@ -99,6 +101,9 @@ export interface CreaturePopulation {
    * bodies one of them sees are deformed and drawn. No arguments: no culling (the default).
    */
   cullWith(...views: Array<Camera | Light>): void;
+  /** Hold a live body still (neither stepped nor re-deformed; still drawn); resume() steps it on. */
+  pause(id: number): void;
+  resume(id: number): void;
   setTier(tier: TierName): void;
   /** Build every shipped variant (deform compute, display, shadow) before the first visible frame. */
   warm(scene: Object3D, camera: Camera): Promise<void>;

@@ -35,7 +35,7 @@ export function createPages(state) {
       // The bodies the passes draw (drawList, its CPU copy `drawn`: live and, when the population culls,
       // seen by one of its views), in instance order; mesh.count is how many.
       drawList, drawn: drawList.value.array, culled: 0,
-      alive: new Uint8Array(size), seed: new Uint32Array(size), spawnTick: new Float64Array(size),
+      alive: new Uint8Array(size), paused: new Uint8Array(size), seed: new Uint32Array(size), spawnTick: new Float64Array(size),
       motions: new Array(size).fill(null), bounds: new Float64Array(6 * size),
       genomes: new Float64Array(GENOME_LENGTH * size), colours: new Float64Array(3 * data.slotCount * size),
       dirtyLo: Infinity, dirtyHi: -1,

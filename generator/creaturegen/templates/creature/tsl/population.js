@@ -173,6 +173,7 @@ export async function createCreaturePopulation(renderer, options = {}) {
           page.motions[j] = createMotion(data.motion, LCG, { support, gravity, water, seed, position, genome });
           genomeColours(data, genome, page.colours, 3 * data.slotCount * j);
           page.alive[j] = 1;
+          page.paused[j] = 0;
           page.seed[j] = seed;
           page.spawnTick[j] = state.tick;
           writeCurrent(state, page, j);
@@ -185,6 +186,7 @@ export async function createCreaturePopulation(renderer, options = {}) {
     despawn(id) {
       const { page, j } = locate(state, id);
       page.alive[j] = 0;
+      page.paused[j] = 0;
       page.motions[j] = null;
       page.genomes.fill(0, GENOME_LENGTH * j, GENOME_LENGTH * (j + 1));
       page.colours.fill(0, 3 * data.slotCount * j, 3 * data.slotCount * (j + 1));
@@ -197,12 +199,13 @@ export async function createCreaturePopulation(renderer, options = {}) {
     stepTicks(n = 1) {
       if (!Number.isInteger(n) || n < 0) throw new Error(`stepTicks: a non-negative integer (got ${n})`);
       advance(state, n);
-      for (const page of pages) for (let j = 0; j < page.size; j++) if (page.alive[j]) writeCurrent(state, page, j);
+      for (const page of pages) for (let j = 0; j < page.size; j++) if (page.alive[j] && !page.paused[j]) writeCurrent(state, page, j);
       return flush(state);
     },
     /**
      * Put the population at tick `n`: each body re-simulated from its spawn to its own tick
-     * n − spawnTick (0 if it was spawned later), so the state equals stepping there tick by tick.
+     * n − spawnTick (0 if it was spawned later), so the state equals stepping there tick by tick. A seek
+     * re-simulates paused bodies too (the timeline knows no pauses; they stay paused at the sought pose).
      */
     seekTick(n) {
       if (!Number.isInteger(n) || n < 0) throw new Error(`seekTick: a non-negative integer (got ${n})`);
@@ -227,13 +230,28 @@ export async function createCreaturePopulation(renderer, options = {}) {
       advance(state, steps);
       for (const page of pages) {
         for (let j = 0; j < page.size; j++) {
-          if (!page.alive[j]) continue;
+          if (!page.alive[j] || page.paused[j]) continue;
           page.motions[j].renderPose(driver.alpha, render.quats, render.trans, render.root);
           writeInstance(state, page, j, render.quats, render.trans, render.root);
         }
       }
       flush(state);
       return steps;
+    },
+    /**
+     * Hold a live body still: it is neither stepped nor rewritten by update() and stepTicks(), so its pose
+     * rows do not change and the pre-pass does not run it again; it is still drawn (an idle creature of a
+     * crowd costs its draw, not its deformation). resume() steps it on from its own tick.
+     */
+    pause(id) {
+      const { page, j } = locate(state, id);
+      if (!page.alive[j]) throw new Error(`pause: instance ${id} is not alive`);
+      page.paused[j] = 1;
+    },
+    resume(id) {
+      const { page, j } = locate(state, id);
+      if (!page.alive[j]) throw new Error(`resume: instance ${id} is not alive`);
+      page.paused[j] = 0;
     },
     /** The fixed-step driver (hz, alpha, accumulator) update() uses. */
     driver,
@@ -242,7 +260,7 @@ export async function createCreaturePopulation(renderer, options = {}) {
     instance(id) {
       const { page, j } = locate(state, id);
       const m = page.motions[j];
-      return { index: j, alive: page.alive[j] === 1, seed: page.seed[j], spawnTick: page.spawnTick[j],
+      return { index: j, alive: page.alive[j] === 1, paused: page.paused[j] === 1, seed: page.seed[j], spawnTick: page.spawnTick[j],
         tick: m ? m.tick : null, root: m ? Array.from(m.root) : null, bounds: Array.from(page.bounds.subarray(6 * j, 6 * j + 6)),
         genome: m ? Array.from(page.genomes.subarray(GENOME_LENGTH * j, GENOME_LENGTH * (j + 1))) : null };
     },

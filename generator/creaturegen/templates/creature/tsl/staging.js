@@ -48,7 +48,7 @@ export function writeCurrent(state, page, j) {
 export function advance(state, n) {
   for (const page of state.pages) {
     for (let j = 0; j < page.size; j++) {
-      if (!page.alive[j]) continue;
+      if (!page.alive[j] || page.paused[j]) continue;
       const m = page.motions[j];
       for (let k = 0; k < n; k++) m.step();
     }
