@@ -76,15 +76,23 @@ async function main() {
   sun.position.set(0, 4 * L, 0);
   sun.castShadow = shadows;
   sun.shadow.mapSize.set(256, 256);
-  const half = 0.5 * extent + L;
-  Object.assign(sun.shadow.camera, { left: -half, right: half, top: half, bottom: -half, near: 0.1 * L, far: 8 * L });
-  sun.shadow.camera.updateProjectionMatrix();
   scene.add(sun);
   scene.add(sun.target);
   const camera = new THREE.PerspectiveCamera(35, width / height, 0.05 * L, 100 * L + 4 * extent);
-  const reach = Math.max(2.2 * L, 0.5 * extent / Math.tan(THREE.MathUtils.degToRad(17.5)) * 1.1);
-  camera.position.set(0.55 * reach, 0.6 * reach, 0.75 * reach);
-  camera.lookAt(0, 0.3 * L, 0);
+  // The camera and the shadow camera frame the middle of the grid: a square of n bodies around the origin.
+  function frameGrid(n) {
+    const s = Math.ceil(Math.sqrt(n));
+    const e = (s - 1) * spacing * L + 2 * L;
+    const half = 0.5 * e + L;
+    Object.assign(sun.shadow.camera, { left: -half, right: half, top: half, bottom: -half, near: 0.1 * L, far: 8 * L });
+    sun.shadow.camera.updateProjectionMatrix();
+    const reach = Math.max(2.2 * L, 0.5 * e / Math.tan(THREE.MathUtils.degToRad(17.5)) * 1.1);
+    camera.position.set(0.55 * reach, 0.6 * reach, 0.75 * reach);
+    camera.lookAt(0, 0.3 * L, 0);
+    camera.updateMatrixWorld();
+    return n;
+  }
+  frameGrid(frameBodies);
 
   // Water for every package (only a swimmer reads it); bodies walk on the default flat ground.
   const pop = await tsl.createCreaturePopulation(renderer, { capacity, pageSize, water: pkg.createAnalyticWater() });
@@ -254,6 +262,7 @@ async function main() {
   // stepTicks to GPU completion; the wait for the tick is not counted. cpuMs: stepTicks + render() only.
   async function timeFrames(frames) {
     const ms = [], cpuMs = [], bytes = [], deformed = [], bodyDraws = [], passDraws = [], instances = [], passes = [];
+    const drawnBodies = [], deformedBodies = [];
     for (let f = 0; f < frames; f++) {
       await tick();
       resetDraws();
@@ -271,8 +280,10 @@ async function main() {
       bodyDraws.push(draws.perPass.reduce((s, x) => s + x, 0));
       passDraws.push(draws.perPass.filter((x) => x > 0));
       instances.push(draws.instances);
+      drawnBodies.push(pop.stats.lastFrameDrawnBodies);
+      deformedBodies.push(pop.stats.lastFrameDeformedBodies);
     }
-    return { variant, ms, cpuMs, bytes, deformed, bodyDraws, passDraws, instances, passes };
+    return { variant, ms, cpuMs, bytes, deformed, bodyDraws, passDraws, instances, passes, drawnBodies, deformedBodies };
   }
 
   const lab = {
@@ -320,6 +331,27 @@ async function main() {
       };
     },
     stats() { return { ...pop.stats, tick: pop.tick, count: pop.count }; },
+    frameGrid,
+    /**
+     * A crowd scenario on the live bodies: the views frame the middle `framed` bodies of the grid, the
+     * population culls against the camera (and the sun when it casts shadows; or not at all, `cull` false),
+     * and every `pauseEvery`-th live body is paused (0: none). Flushes, and returns live, paused and the
+     * bodies the flush left drawn.
+     */
+    crowd({ framed = pop.capacity, cull = true, pauseEvery = 0 } = {}) {
+      frameGrid(framed);
+      // The sun's view counts only when it casts shadows (its shadow pass draws the bodies it sees).
+      if (cull) pop.cullWith(...(shadows ? [camera, sun] : [camera])); else pop.cullWith();
+      let live = 0, paused = 0;
+      for (let i = 0; i < pop.capacity; i++) {
+        if (!pop.instance(i).alive) continue;
+        const hold = pauseEvery > 0 && live % pauseEvery === 0;
+        if (hold) { pop.pause(i); paused++; } else pop.resume(i);
+        live++;
+      }
+      pop.flush();
+      return { live, paused, framed, cull, drawn: pop.stats.lastFrameDrawnBodies };
+    },
     async finish() { await device.queue.onSubmittedWorkDone(); return errors.length; },
   };
   window.__lab = lab;

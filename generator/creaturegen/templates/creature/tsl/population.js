@@ -122,10 +122,10 @@ export async function createCreaturePopulation(renderer, options = {}) {
     // Scratch for writing rows and bounds, reused by every body every frame.
     scratch: {
       tmp: new Float64Array(3), localBox: new Float64Array(6), corner: new THREE.Vector3(), box: new THREE.Box3(),
-      previous: new Float32Array(floatsPerInstance), bodyBox: new THREE.Box3(), matrix: new THREE.Matrix4(),
+      previous: new Float32Array(floatsPerInstance), matrix: new THREE.Matrix4(),
     },
     // The views the population culls against (cullWith) and their frusta, refreshed at every flush.
-    views: [], frusta: [], viewsChanged: false,
+    views: [], frusta: [], planes: new Float64Array(0), groupMatrix: new Float64Array(16), viewsChanged: false,
     tick: 0,
     mode: checkDebugMode(options.debugMode ?? 'off'),
   };
@@ -296,6 +296,7 @@ export async function createCreaturePopulation(renderer, options = {}) {
       }
       state.views = views;
       state.frusta = views.map(() => new THREE.Frustum());
+      state.planes = new Float64Array(24 * views.length);
       state.viewsChanged = true;
     },
     setTier(t) {

@@ -59,12 +59,15 @@ export function advance(state, n) {
 
 /**
  * The population's culling views for this flush: each camera's frustum (a shadow-casting light's shadow
- * camera, its matrices brought up to date first) and the group's world matrix, so that bounds in
- * population space can be tested in world space. Nothing is allocated (the frusta exist per view).
+ * camera, its matrices brought up to date first) as six planes in `state.planes`, and the group's world
+ * matrix in `state.groupMatrix`, so that bounds in population space are tested in world space. Plain
+ * Float64Arrays: the per-body test below stores no double into an object (which V8 may box), so the
+ * steady loop allocates nothing.
  */
 export function updateViews(state) {
-  const { views, frusta, scratch } = state;
+  const { views, frusta, planes, groupMatrix, scratch } = state;
   state.group.updateWorldMatrix(true, false);
+  groupMatrix.set(state.group.matrixWorld.elements);
   for (let i = 0; i < views.length; i++) {
     let camera = views[i];
     if (camera.isLight) {
@@ -77,20 +80,67 @@ export function updateViews(state) {
     }
     scratch.matrix.multiplyMatrices(camera.projectionMatrix, camera.matrixWorldInverse);
     frusta[i].setFromProjectionMatrix(scratch.matrix, camera.coordinateSystem, camera.reversedDepth);
+    for (let k = 0; k < 6; k++) {
+      const plane = frusta[i].planes[k];
+      const o = 24 * i + 4 * k;
+      planes[o] = plane.normal.x;
+      planes[o + 1] = plane.normal.y;
+      planes[o + 2] = plane.normal.z;
+      planes[o + 3] = plane.constant;
+    }
   }
 }
 
-// Whether body j's posed bounds meet one of the views (without views every body is seen).
+// Whether body j's posed bounds meet one of the views (without views every body is seen): the box's centre
+// and half extents carried into world space by the group's affine matrix (|M| for the extents), then for
+// each frustum the plane test of its farthest corner along the plane's normal (three's Frustum.intersectsBox).
 function seen(state, page, j) {
-  const { frusta, scratch } = state;
-  if (frusta.length === 0) return true;
+  const views = state.views.length;
+  if (views === 0) return true;
   const b = page.bounds;
-  const box = scratch.bodyBox;
-  box.min.set(b[6 * j], b[6 * j + 1], b[6 * j + 2]);
-  box.max.set(b[6 * j + 3], b[6 * j + 4], b[6 * j + 5]);
-  box.applyMatrix4(state.group.matrixWorld);
-  for (let i = 0; i < frusta.length; i++) if (frusta[i].intersectsBox(box)) return true;
+  const m = state.groupMatrix;
+  const planes = state.planes;
+  const o = 6 * j;
+  const cx = 0.5 * (b[o] + b[o + 3]), cy = 0.5 * (b[o + 1] + b[o + 4]), cz = 0.5 * (b[o + 2] + b[o + 5]);
+  const ex = 0.5 * (b[o + 3] - b[o]), ey = 0.5 * (b[o + 4] - b[o + 1]), ez = 0.5 * (b[o + 5] - b[o + 2]);
+  const wx = m[0] * cx + m[4] * cy + m[8] * cz + m[12];
+  const wy = m[1] * cx + m[5] * cy + m[9] * cz + m[13];
+  const wz = m[2] * cx + m[6] * cy + m[10] * cz + m[14];
+  const hx = Math.abs(m[0]) * ex + Math.abs(m[4]) * ey + Math.abs(m[8]) * ez;
+  const hy = Math.abs(m[1]) * ex + Math.abs(m[5]) * ey + Math.abs(m[9]) * ez;
+  const hz = Math.abs(m[2]) * ex + Math.abs(m[6]) * ey + Math.abs(m[10]) * ez;
+  for (let v = 0; v < views; v++) {
+    let inside = true;
+    for (let k = 0; k < 6 && inside; k++) {
+      const p = 24 * v + 4 * k;
+      const nx = planes[p], ny = planes[p + 1], nz = planes[p + 2];
+      const reach = Math.abs(nx) * hx + Math.abs(ny) * hy + Math.abs(nz) * hz;
+      inside = nx * wx + ny * wy + nz * wz + planes[p + 3] + reach >= 0;
+    }
+    if (inside) return true;
+  }
   return false;
+}
+
+/**
+ * Mark `count` elements from `start` of a storage attribute for the next upload through one reusable range
+ * object (`range`): merged with a pending upload of the same range instead of allocating another (three's
+ * addUpdateRange allocates one per call; its backend consumes the ranges when it uploads).
+ */
+function markRange(attribute, range, start, count) {
+  const ranges = attribute.updateRanges;
+  if (ranges.length === 0) {
+    range.start = start;
+    range.count = count;
+    ranges.push(range);
+  } else if (ranges.length === 1 && ranges[0] === range) {
+    const end = Math.max(range.start + range.count, start + count);
+    range.start = Math.min(range.start, start);
+    range.count = end - range.start;
+  } else {
+    attribute.addUpdateRange(start, count);
+  }
+  attribute.needsUpdate = true;
 }
 
 /**
@@ -113,10 +163,7 @@ export function refreshDrawn(state, page) {
     box.expandByPoint(corner.set(b[6 * j], b[6 * j + 1], b[6 * j + 2]));
     box.expandByPoint(corner.set(b[6 * j + 3], b[6 * j + 4], b[6 * j + 5]));
   }
-  if (changed) {
-    page.drawList.value.addUpdateRange(0, n);
-    page.drawList.value.needsUpdate = true;
-  }
+  if (changed) markRange(page.drawList.value, page.ranges.drawList, 0, n);
   page.culled = culled;
   page.mesh.count = n;
   if (page.shell) page.shell.count = page.mesh.count * state.data.slotCount;
@@ -139,8 +186,7 @@ export function deformMoved(state, page) {
   }
   state.stats.lastFrameDeformedBodies += n;
   if (n === 0) return 0;
-  page.list.value.addUpdateRange(0, n);
-  page.list.value.needsUpdate = true;
+  markRange(page.list.value, page.ranges.list, 0, n);
   state.stats.deformDispatches += 1;
   return dispatchDeform(state.renderer, page.kernel, n);
 }
@@ -171,8 +217,7 @@ export function flush(state) {
     if (dirty) {
       const start = page.dirtyLo * floatsPerInstance;
       const count = (page.dirtyHi - page.dirtyLo + 1) * floatsPerInstance;
-      page.pose.value.addUpdateRange(start, count);
-      page.pose.value.needsUpdate = true;
+      markRange(page.pose.value, page.ranges.pose, start, count);
       bytes += 4 * count;
     }
     if (dirty || culling || state.viewsChanged) refreshDrawn(state, page);
