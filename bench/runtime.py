@@ -56,7 +56,11 @@ WEB_LAB = REPO / "generator" / "creaturegen" / "web_lab"
 HOPPER_SPEC = REPO / "examples" / "reference" / "hopper.json"
 HOPPER_SLUG = "hopper-squash-core"
 DEFAULT_PACKAGE = REPO / "out" / HOPPER_SLUG
-VARIANTS = ("shipped", "baseline")
+VARIANTS = ("shipped", "baseline", "lbs")
+#: The field-query kernels (the plain-LBS baseline queries no field).
+FIELD_VARIANTS = ("shipped", "baseline")
+#: The issue 27 bar: a visible moving hero body at most this many times the plain-LBS body.
+LBS_TARGET = 3.0
 
 #: The population sizes of the issue.
 DEFAULT_BODIES = (1, 16, 64, 256)
@@ -234,6 +238,7 @@ def measure_population(
     ratios = [
         statistics.median(rd["baseline"]["ms"]) / statistics.median(rd["shipped"]["ms"]) for rd in rounds
     ]
+    over_lbs = [statistics.median(rd["shipped"]["ms"]) / statistics.median(rd["lbs"]["ms"]) for rd in rounds]
     return {
         "bodies": bodies,
         "live_bodies": int(state["count"]),
@@ -266,6 +271,7 @@ def measure_population(
             "median": float(statistics.median(ratios)),
             "p50_over_p50": variants["baseline"]["ms"]["p50"] / variants["shipped"]["ms"]["p50"],
         },
+        "ratio_shipped_over_lbs": {"per_round": over_lbs, "median": float(statistics.median(over_lbs))},
     }
 
 
@@ -280,8 +286,8 @@ def measure_field_queries(bench: Bench, reps: int, copies: int) -> dict[str, Any
         "vertices": timed["vertices"],
         "copies": copies,
         "repeats": reps,
-        "ms_per_dispatch": {v: ms_summary(ms[v]) for v in VARIANTS},
-        "us_per_query": {v: 1000 * quantile(ms[v], 0.5) / timed["points"] for v in VARIANTS},
+        "ms_per_dispatch": {v: ms_summary(ms[v]) for v in FIELD_VARIANTS},
+        "us_per_query": {v: 1000 * quantile(ms[v], 0.5) / timed["points"] for v in FIELD_VARIANTS},
         "measured_ratio_baseline_over_shipped": float(statistics.median(per_rep)),
         "check": check,
     }
@@ -346,10 +352,12 @@ def run_package(folder: Path, args: argparse.Namespace, log: Callable[[str], Non
     slots, registers = int(info["slots"]), int(info["registers"])
     counts = [p["bodies"] for p in populations]
     marginal = {v: fit_line(counts, [p["variants"][v]["ms"]["p50"] for p in populations]) for v in VARIANTS}
-    slope_ratio = None
-    shipped_fit, baseline_fit = marginal["shipped"], marginal["baseline"]
+    slope_ratio = lbs_ratio = None
+    shipped_fit, baseline_fit, lbs_fit = marginal["shipped"], marginal["baseline"], marginal["lbs"]
     if shipped_fit is not None and baseline_fit is not None and shipped_fit["slope"] > 0:
         slope_ratio = baseline_fit["slope"] / shipped_fit["slope"]
+    if shipped_fit is not None and lbs_fit is not None and lbs_fit["slope"] > 0:
+        lbs_ratio = shipped_fit["slope"] / lbs_fit["slope"]
     shadow_passes = sorted({n - 1 for p in populations for n in p["draws"]["passes_drawing_bodies"]})
     workload = {
         "slots": slots,
@@ -393,7 +401,19 @@ def run_package(folder: Path, args: argparse.Namespace, log: Callable[[str], Non
         },
         "field_queries": field,
         "populations": populations,
-        "marginal_ms_per_body": {**marginal, "ratio_baseline_over_shipped": slope_ratio},
+        "marginal_ms_per_body": {
+            **marginal,
+            "ratio_baseline_over_shipped": slope_ratio,
+            "ratio_shipped_over_lbs": lbs_ratio,
+        },
+        "targets": [
+            {
+                "name": f"marginal ms per visible moving body: shipped ({info['tier']}) / plain LBS",
+                "value": lbs_ratio,
+                "target": LBS_TARGET,
+                "met": lbs_ratio is not None and lbs_ratio <= LBS_TARGET,
+            }
+        ],
         "measured_vs_predicted": {
             "predicted_7P_over_K": 7 * slots / registers,
             "field_query_ratio": field["measured_ratio_baseline_over_shipped"],
@@ -448,9 +468,11 @@ def table(report: dict[str, Any]) -> str:
             return "n/a" if fit is None else f"{fit['slope']:.1f}"
 
         ratio = m["marginal_per_body_ratio"]
+        over_lbs = mg["ratio_shipped_over_lbs"]
         lines.append(
             f"marginal ms/body: shipped {slope(mg['shipped'])}, baseline {slope(mg['baseline'])}"
-            f" (ratio {'n/a' if ratio is None else f'{ratio:.2f}'})"
+            f" (ratio {'n/a' if ratio is None else f'{ratio:.2f}'}), plain LBS {slope(mg['lbs'])}"
+            f" (shipped/LBS {'n/a' if over_lbs is None else f'{over_lbs:.2f}'})"
         )
         lines.append(
             f"field query ({f['points']} points): shipped {f['ms_per_dispatch']['shipped']['p50']:.1f} ms, "
@@ -464,6 +486,35 @@ def table(report: dict[str, Any]) -> str:
             f"whole loop {sp['batch_ms_per_spawn']:.4f} ms/spawn"
         )
     return "\n".join(lines)
+
+
+#: The issue 27 bar: a distant-tier body at most this fraction of a hero body of the same creature.
+DISTANT_TARGET = 0.25
+
+
+def tier_ratios(results: list[dict[str, Any]]) -> list[dict[str, Any]]:
+    """For every package measured at the hero tier and again at a lower tier in this run (same creature:
+    the same name, other tier): the lower tier's marginal ms per body over the hero's (shipped pre-pass),
+    with the issue's bar for the distant tier."""
+    hero = {r["package"]: r for r in results if r["workload"]["tier"] == "hero"}
+    out = []
+    for r in results:
+        tier, base = r["workload"]["tier"], hero.get(r["package"])
+        if tier == "hero" or base is None:
+            continue
+        low, high = r["marginal_ms_per_body"]["shipped"], base["marginal_ms_per_body"]["shipped"]
+        ratio = low["slope"] / high["slope"] if low and high and high["slope"] > 0 else None
+        out.append(
+            {
+                "package": r["package"],
+                "tier": tier,
+                "ms_per_body": {"hero": high["slope"] if high else None, tier: low["slope"] if low else None},
+                "ratio_over_hero": ratio,
+                "target": DISTANT_TARGET if tier == "distant" else None,
+                "met": None if tier != "distant" else ratio is not None and ratio <= DISTANT_TARGET,
+            }
+        )
+    return out
 
 
 def main(argv: Sequence[str] | None = None) -> int:
@@ -527,12 +578,15 @@ def main(argv: Sequence[str] | None = None) -> int:
             "round; the material order flips every round",
         },
         "results": results,
+        "tier_ratios": tier_ratios(results),
         "notes": NOTES,
         "wall_seconds": time.perf_counter() - started,
     }
     args.out.parent.mkdir(parents=True, exist_ok=True)
     args.out.write_text(json.dumps(report, indent=2) + "\n")
     print(table(report), flush=True)
+    for t in report["tier_ratios"]:
+        print(f"{t['package']}: {t['tier']} / hero ms per body = {t['ratio_over_hero']}", flush=True)
     log(f"wrote {args.out} ({report['wall_seconds']:.1f} s)")
     return 0
 

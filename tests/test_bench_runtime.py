@@ -101,11 +101,17 @@ def test_runtime_benchmark_smoke(tmp_path: Path, capsys: pytest.CaptureFixture[s
             assert timing["ms"]["p50"] <= timing["ms"]["p95"]
             assert _positive_finite(timing["cpu_ms"]["p50"])
         assert _positive_finite(population["ratio_baseline_over_shipped"]["median"])
+        assert _positive_finite(population["ratio_shipped_over_lbs"]["median"])
 
     marginal = result["marginal_ms_per_body"]
     for variant in bench.VARIANTS:
         assert math.isfinite(marginal[variant]["slope"])
         assert math.isfinite(marginal[variant]["intercept"])
+    # The plain-LBS baseline beside the shipped body: the bar as a target (met or not, measured).
+    (target,) = result["targets"]
+    assert target["target"] == bench.LBS_TARGET
+    assert target["value"] == marginal["ratio_shipped_over_lbs"]
+    assert target["met"] == (target["value"] is not None and target["value"] <= bench.LBS_TARGET)
 
     # The baseline evaluates the same field: equal distances, central-difference gradients along the
     # analytic ones (a measured property of the two kernels, read back from the GPU).
@@ -115,7 +121,7 @@ def test_runtime_benchmark_smoke(tmp_path: Path, capsys: pytest.CaptureFixture[s
     assert check["maxAbsDistanceOverBodyScale"] < 1e-5
     assert check["gradientsCompared"] > 0.9 * field["points"]
     assert check["gradientAngleDeg"]["median"] < 1.0
-    for variant in bench.VARIANTS:
+    for variant in bench.FIELD_VARIANTS:
         assert _positive_finite(field["ms_per_dispatch"][variant]["p50"])
     assert _positive_finite(field["measured_ratio_baseline_over_shipped"])
 

@@ -12,7 +12,7 @@
 // baseline evaluates 7·P slot distances where the shipped path runs one K-instruction tape that carries
 // distance and gradient together: the seed's ratio 7P/K at equal depth.
 import {
-  Fn, If, Loop, abs, array, clamp, exp, float, int, log, max, min, select, sqrt, vec3, vec4,
+  Fn, If, Loop, abs, array, clamp, exp, float, instanceIndex, int, log, max, min, select, sqrt, vec3, vec4,
 } from 'three/tsl';
 
 const dot3 = (u, v) => u.x.mul(v.x).add(u.y.mul(v.y)).add(u.z.mul(v.z));
@@ -151,4 +151,38 @@ export function createBaselineKernel(tsl, layout, page, records, programs, step)
   return tsl.createDeformKernel(layout, fns, {
     pose: page.pose, records, deform: page.deform, list: page.list, size: page.size, vertices: layout.vertices,
   });
+}
+
+/**
+ * The plain-LBS baseline of one page: what a three.js SkinnedMesh (or an instanced skinned mesh) does with
+ * the same mesh. Every vertex of the listed bodies is skinned by linear blend skinning alone (the
+ * package's createSkin lbs), its normal by the cofactor of the blended matrix (lbsNormal) and its colour
+ * blended from its four influences' slot colours (bakedColour); no correction, no field evaluation. It
+ * writes the page's own deform storage through the page's own instance list, so the material, the root
+ * transform, the uploads and the draws are the shipped ones: only the body path differs.
+ */
+export function createLbsKernel(tsl, layout, page, records, programs) {
+  const fns = tsl.bodyFunctions(layout, page.pose, programs);
+  const vertices = layout.vertices;
+  const rowsPerInstance = layout.maxParts * layout.rows;
+  const kernel = Fn(() => {
+    const entry = int(instanceIndex).div(vertices).toVar();
+    const v = int(instanceIndex).sub(entry.mul(vertices)).toVar();
+    const j = page.list.element(entry).toVar();
+    const base = j.mul(rowsPerInstance).toVar();
+    const alive = page.pose.element(base.add(layout.slotCount * layout.rows)).w;
+    If(alive.greaterThan(0.5), () => {
+      const r = tsl.recordInputs(records, v);
+      const s = fns.field.size(base).toVar();
+      const position = fns.skin.lbs(r.rest.mul(s), base, r.slots, r.weights);
+      const normal = fns.skin.lbsNormal(r.normal, base, r.slots, r.weights);
+      const colour = fns.field.bakedColour(base, r.slots, r.weights);
+      const o = j.mul(vertices).add(v).mul(tsl.DEFORM_STRIDE).toVar();
+      page.deform.element(o).assign(vec4(position, 0));
+      page.deform.element(o.add(1)).assign(vec4(normal, 0));
+      page.deform.element(o.add(2)).assign(vec4(colour, float(layout.skinProgram)));
+    });
+  })().compute(page.size * vertices);
+  kernel.setName('cgDeformPlainLbs');
+  return { kernel, list: page.list, vertices, size: page.size };
 }

@@ -4,7 +4,7 @@
 // to GPU completion, upload bytes from the population, draw calls from the WebGPU encoders, spawn times.
 import * as THREE from 'three/webgpu';
 import { Fn, instanceIndex, instancedArray, int } from 'three/tsl';
-import { baselineFunctions, createBaselineKernel } from './creature-baseline.js';
+import { baselineFunctions, createBaselineKernel, createLbsKernel } from './creature-baseline.js';
 import { countDraws } from './lab-common.js';
 
 const params = new URLSearchParams(location.search);
@@ -106,10 +106,12 @@ async function main() {
   const kernels = {
     shipped: pop.pages.map((p) => p.kernel),
     baseline: pop.pages.map((p) => createBaselineKernel(tsl, layout, p, internals.records, internals.programs, step)),
+    // What a SkinnedMesh does: linear blend skinning alone, no correction, no field (lab code too).
+    lbs: pop.pages.map((p) => createLbsKernel(tsl, layout, p, internals.records, internals.programs)),
   };
   let variant = 'shipped';
   function setVariant(v) {
-    if (!(v in kernels)) throw new Error(`variant: shipped or baseline (got ${v})`);
+    if (!(v in kernels)) throw new Error(`variant: shipped, baseline or lbs (got ${v})`);
     pop.pages.forEach((p, i) => { p.kernel = kernels[v][i]; });
     variant = v;
   }
@@ -140,7 +142,7 @@ async function main() {
   const t0 = performance.now();
   spawn(1, 1);
   const compileMs = {};
-  for (const v of ['shipped', 'baseline']) {
+  for (const v of ['shipped', 'baseline', 'lbs']) {
     const start = performance.now();
     setVariant(v);
     console.log(`creature bench: compiling ${v}`);
