@@ -32,21 +32,9 @@ import time
 from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
-from urllib.parse import urlencode
 
 from benchlib import machine
-from creaturegen.lab.browser import launch_lab_page
-from creaturegen.lab.server import serve
-from runtime import (
-    BROWSER_FLAGS,
-    DEFAULT_PACKAGE,
-    FD_STEP,
-    WEB_LAB,
-    Bench,
-    ensure_package,
-    ms_summary,
-    parse_canvas,
-)
+from runtime import DEFAULT_PACKAGE, Bench, ensure_package, ms_summary, open_bench, parse_canvas
 
 REPO = Path(__file__).resolve().parents[1]
 #: The issue's bar: the crowd's frame at most this fraction of the all-in-view, all-moving frame.
@@ -130,29 +118,16 @@ def main(argv: Sequence[str] | None = None) -> int:
     args = parser.parse_args(argv)
     folder: Path = args.package.resolve()
     ensure_package(folder, log)
-    query = {
-        "pkg": folder.name,
-        "w": args.canvas[0],
-        "h": args.canvas[1],
-        "capacity": args.bodies,
-        "pageSize": args.page_size,
-        "frame": args.bodies,
-        "shadows": 1 if args.shadows else 0,
-        "fdStep": FD_STEP,
-    }
     started = time.perf_counter()
-    with serve(WEB_LAB, mounts={"out": folder.parent}) as base_url:
-        url = f"{base_url}creature-bench.html?{urlencode(query)}"
-        with launch_lab_page(url, timeout_s=args.timeout, extra_args=BROWSER_FLAGS) as page:
-            bench = Bench(page)
-            info = bench.info()
-            log(f"  page ready in {time.perf_counter() - started:.1f} s; spawning {args.bodies}")
-            population = bench.population(args.bodies)
-            log(f"  {population['count']} bodies on {population['pagesInUse']} pages")
-            framing, drawn = framing_for(bench, args.bodies, args.in_view)
-            log(f"  crowd framing: the middle {framing} bodies framed, {drawn} of {args.bodies} seen")
-            measured = measure(bench, scenarios(args.bodies, framing), args.frames, args.repeats)
-            errors = bench.gpu_errors()
+    with open_bench(folder, args, args.bodies, args.bodies) as (bench, _):
+        info = bench.info()
+        log(f"  page ready in {time.perf_counter() - started:.1f} s; spawning {args.bodies}")
+        population = bench.population(args.bodies)
+        log(f"  {population['count']} bodies on {population['pagesInUse']} pages")
+        framing, drawn = framing_for(bench, args.bodies, args.in_view)
+        log(f"  crowd framing: the middle {framing} bodies framed, {drawn} of {args.bodies} seen")
+        measured = measure(bench, scenarios(args.bodies, framing), args.frames, args.repeats)
+        errors = bench.gpu_errors()
     ratio = measured["ratio_crowd_over_all"]["median"]
     report = {
         "benchmark": "crowd",

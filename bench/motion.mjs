@@ -12,8 +12,8 @@
 // allocation (V8 heap growth and garbage collections over a run of steps, after a full collection), and,
 // for creatures with ropes, the rope cost against substeps × passes × segments. Bench code: it may use
 // wall clocks; the shipped core it measures may not.
-import { PerformanceObserver, performance } from 'node:perf_hooks';
 import { pathToFileURL } from 'node:url';
+import { allocationWindows } from './alloc.mjs';
 
 const [corePath, optionsText] = process.argv.slice(2);
 if (!corePath) throw new Error('usage: node --expose-gc bench/motion.mjs <package>/core/index.js [json options]');
@@ -56,38 +56,11 @@ function run(m, steps) {
   for (let k = 0; k < steps; k++) m.step();
 }
 
-/**
- * Heap growth and collections over `allocSteps` steady-state steps of one body, after `allocWarm` steps
- * through the same loop (V8 needs thousands of steps to settle its optimised code: until then unoptimised
- * code boxes every double, and compiling allocates too). `allocRounds` windows, each after a full
- * collection; the cleanest window is the steady state (a window can still catch a late compilation), and
- * every window is reported. Cleanest means the fewest collections, then the least growth: a collection
- * inside a window frees memory, so its growth alone understates what the window allocated.
- */
+/** Allocation of `allocSteps` steady-state steps of one body (bench/alloc.mjs). */
 async function allocation(motionData) {
   const [m] = bodies(motionData, 1);
-  for (let k = 0; k < 4; k++) run(m, options.allocWarm / 4);
-  const gcTimes = [];
-  const observer = new PerformanceObserver((list) => { for (const e of list.getEntries()) gcTimes.push(e.startTime); });
-  observer.observe({ entryTypes: ['gc'] });
-  const settle = () => new Promise((resolve) => setTimeout(resolve, 20)); // let gc entries arrive
-  const windows = [];
-  for (let r = 0; r < options.allocRounds; r++) {
-    globalThis.gc();
-    await settle();
-    const start = performance.now();
-    const before = process.memoryUsage().heapUsed;
-    run(m, options.allocSteps);
-    const after = process.memoryUsage().heapUsed;
-    const end = performance.now();
-    await settle();
-    // Collections that started inside the window (the forced one before it is not counted).
-    windows.push({ heapGrowthBytes: after - before, collections: gcTimes.filter((t) => t >= start && t <= end).length });
-  }
-  observer.disconnect();
-  const cleaner = (w, a) => w.collections < a.collections || (w.collections === a.collections && w.heapGrowthBytes < a.heapGrowthBytes);
-  const best = windows.reduce((a, w) => (cleaner(w, a) ? w : a));
-  return { steps: options.allocSteps, heapGrowthBytes: best.heapGrowthBytes, bytesPerStep: best.heapGrowthBytes / options.allocSteps, collections: best.collections, windows };
+  const best = await allocationWindows((n) => run(m, n), { warm: options.allocWarm, window: options.allocSteps, rounds: options.allocRounds });
+  return { steps: options.allocSteps, bytesPerStep: best.heapGrowthBytes / options.allocSteps, ...best };
 }
 
 const motion = data.motion;

@@ -10,8 +10,9 @@
 // per scenario, and steady-state allocation (V8 heap growth and garbage collections over a window of frames
 // after a full collection, as bench/motion.mjs probes the locomotion core). Bench code: it may use clocks.
 import { readFileSync } from 'node:fs';
-import { PerformanceObserver, performance } from 'node:perf_hooks';
+import { performance } from 'node:perf_hooks';
 import { fileURLToPath, pathToFileURL } from 'node:url';
+import { allocationWindows } from './alloc.mjs';
 
 const [packageDir, optionsText] = process.argv.slice(2);
 if (!packageDir) throw new Error('usage: node --expose-gc bench/population.mjs <package copy> [json options]');
@@ -102,27 +103,8 @@ function cost(name) {
 
 async function allocation(name) {
   scenarios[name]();
-  for (let k = 0; k < 4; k++) frames(options.allocWarm / 4, null);
-  const gcTimes = [];
-  const observer = new PerformanceObserver((list) => { for (const e of list.getEntries()) gcTimes.push(e.startTime); });
-  observer.observe({ entryTypes: ['gc'] });
-  const settle = () => new Promise((resolve) => setTimeout(resolve, 20));
-  const windows = [];
-  for (let r = 0; r < options.allocRounds; r++) {
-    globalThis.gc();
-    await settle();
-    const start = performance.now();
-    const before = process.memoryUsage().heapUsed;
-    frames(options.allocFrames, null);
-    const after = process.memoryUsage().heapUsed;
-    const end = performance.now();
-    await settle();
-    windows.push({ heapGrowthBytes: after - before, collections: gcTimes.filter((t) => t >= start && t <= end).length });
-  }
-  observer.disconnect();
-  const cleaner = (w, a) => w.collections < a.collections || (w.collections === a.collections && w.heapGrowthBytes < a.heapGrowthBytes);
-  const best = windows.reduce((a, w) => (cleaner(w, a) ? w : a));
-  return { scenario: name, frames: options.allocFrames, heapGrowthBytes: best.heapGrowthBytes, bytesPerFrame: best.heapGrowthBytes / options.allocFrames, collections: best.collections, windows };
+  const best = await allocationWindows((n) => frames(n, null), { warm: options.allocWarm, window: options.allocFrames, rounds: options.allocRounds });
+  return { scenario: name, frames: options.allocFrames, bytesPerFrame: best.heapGrowthBytes / options.allocFrames, ...best };
 }
 
 async function allocations(names) {

@@ -36,13 +36,14 @@ default package (``out/hopper-squash-core``) is built first with ``creaturegen b
 from __future__ import annotations
 
 import argparse
+import contextlib
 import json
 import math
 import statistics
 import subprocess
 import sys
 import time
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Iterator, Sequence
 from pathlib import Path
 from typing import Any
 from urllib.parse import urlencode
@@ -311,43 +312,52 @@ def measure_spawns(bench: Bench, spawns: int) -> dict[str, Any]:
     }
 
 
+@contextlib.contextmanager
+def open_bench(
+    folder: Path, args: argparse.Namespace, capacity: int, frame: int
+) -> Iterator[tuple[Bench, LabPage]]:
+    """The bench lab page on the package in ``folder`` (served with its parent as /out/): ``capacity``
+    bodies in pages of ``args.page_size``, the views framing ``frame`` of them, ``args.canvas`` and
+    ``args.shadows``."""
+    query = {
+        "pkg": folder.name,
+        "w": args.canvas[0],
+        "h": args.canvas[1],
+        "capacity": capacity,
+        "pageSize": args.page_size,
+        "frame": frame,
+        "shadows": 1 if args.shadows else 0,
+        "fdStep": FD_STEP,
+    }
+    with serve(WEB_LAB, mounts={"out": folder.parent}) as base_url:
+        url = f"{base_url}creature-bench.html?{urlencode(query)}"
+        with launch_lab_page(url, timeout_s=args.timeout, extra_args=BROWSER_FLAGS) as page:
+            yield Bench(page), page
+
+
 def run_package(folder: Path, args: argparse.Namespace, log: Callable[[str], None]) -> dict[str, Any]:
     built = ensure_package(folder, log)
     report = json.loads((folder / "build-report.json").read_text())
     pose_bytes = int(report["workload"]["poseBytesPerBody"])
-    canvas: tuple[int, int] = args.canvas
-    query = {
-        "pkg": folder.name,
-        "w": canvas[0],
-        "h": canvas[1],
-        "capacity": args.capacity,
-        "pageSize": args.page_size,
-        "frame": max(args.bodies),
-        "shadows": 1 if args.shadows else 0,
-        "fdStep": FD_STEP,
-    }
     started = time.perf_counter()
-    with serve(WEB_LAB, mounts={"out": folder.parent}) as base_url:
-        url = f"{base_url}creature-bench.html?{urlencode(query)}"
-        with launch_lab_page(url, timeout_s=args.timeout, extra_args=BROWSER_FLAGS) as page:
-            bench = Bench(page)
-            info = bench.info()
-            boot = {"boot_ms": page.lab["bootMs"], "compile_ms": page.lab["compileMs"]}
-            log(f"  page ready in {time.perf_counter() - started:.1f} s (compile ms {boot['compile_ms']})")
-            env = environment(page)
-            log("  field queries (compute kernels)")
-            field = measure_field_queries(bench, args.field_repeats, args.field_copies)
-            populations = []
-            for bodies in args.bodies:
-                log(f"  population of {bodies}")
-                populations.append(
-                    measure_population(
-                        bench, bodies, args.frames, args.repeats, pose_bytes, int(info["vertices"]), log
-                    )
+    with open_bench(folder, args, args.capacity, max(args.bodies)) as (bench, page):
+        info = bench.info()
+        boot = {"boot_ms": page.lab["bootMs"], "compile_ms": page.lab["compileMs"]}
+        log(f"  page ready in {time.perf_counter() - started:.1f} s (compile ms {boot['compile_ms']})")
+        env = environment(page)
+        log("  field queries (compute kernels)")
+        field = measure_field_queries(bench, args.field_repeats, args.field_copies)
+        populations = []
+        for bodies in args.bodies:
+            log(f"  population of {bodies}")
+            populations.append(
+                measure_population(
+                    bench, bodies, args.frames, args.repeats, pose_bytes, int(info["vertices"]), log
                 )
-            log(f"  spawn cost ({args.spawns} spawns)")
-            spawn = measure_spawns(bench, args.spawns)
-            errors = bench.gpu_errors()
+            )
+        log(f"  spawn cost ({args.spawns} spawns)")
+        spawn = measure_spawns(bench, args.spawns)
+        errors = bench.gpu_errors()
 
     slots, registers = int(info["slots"]), int(info["registers"])
     counts = [p["bodies"] for p in populations]
