@@ -442,33 +442,46 @@ def test_the_job_catches_a_population_that_steps_paused_bodies(out_root: Path, t
 
 @pytest.mark.browser
 @pytest.mark.parametrize(
-    ("planted_defect", "swap", "gates"),
+    ("planted_defect", "file", "swap", "gates"),
     [
         (
             "culled bodies drawn and deformed anyway",
+            "staging.js",
             ("if (!seen(state, page, j)) { culled++; continue; }", "if (!seen(state, page, j)) culled++;"),
-            {"bodies drawn in body 0's portrait view of 10 spread 4.0 L apart (rest culled)"},
+            {"bodies drawn in body 0's portrait view of 5 spread 6.0 L apart (rest culled)"},
         ),
         (
             "a pre-pass that forgets the bodies that moved while culled",
+            "staging.js",
             (
                 "  state.stats.lastFrameDeformedBodies += n;\n",
                 "  page.moved.fill(0);\n  state.stats.lastFrameDeformedBodies += n;\n",
             ),
             {
                 "bodies deformed when culling stops vs the bodies culled while they moved",
-                "drawn vertices of 10 bodies after culling vs every body deformed afresh (bytes)",
+                "drawn vertices of 5 bodies after culling vs the GPU body path at their pose",
             },
+        ),
+        (
+            "a cull that allocates a GPU buffer whenever its views change",
+            "population.js",
+            (
+                "      state.viewsChanged = true;\n",
+                "      state.viewsChanged = true;\n"
+                "      state.renderer.backend.device.createBuffer({ size: 256, usage: 128 });\n",  # STORAGE
+            ),
+            {"pipelines and buffers created by culling on, a culled tick and culling off (device count)"},
         ),
     ],
 )
 def test_the_job_catches_wrong_culling(
-    out_root: Path, tmp_path: Path, planted_defect: str, swap: tuple[str, str], gates: set[str]
+    out_root: Path, tmp_path: Path, planted_defect: str, file: str, swap: tuple[str, str], gates: set[str]
 ) -> None:
-    """Culling by posed bounds (cullWith): a cull that keeps drawing what it culls, and one that loses the
-    bodies that moved while culled (they come back with a stale surface), each fail their gates."""
+    """Culling by posed bounds (cullWith): a cull that keeps drawing what it culls, one that loses the
+    bodies that moved while culled (they come back with a stale surface), and one that creates a GPU
+    buffer when its views change, each fail their gates."""
     package = build("reference/hopper.json", out_root)
-    report = run_creature_parity(_planted(package, tmp_path, "staging.js", [swap]), groups=("cull",))
+    report = run_creature_parity(_planted(package, tmp_path, file, [swap]), groups=("cull",))
     failed, summary = {g["name"] for g in report.gates if g["status"] == "fail"}, report.summary()
     assert gates <= failed, (planted_defect, summary)
 

@@ -98,7 +98,7 @@ def run_creature_parity(
         pictures(page, package, debug_pictures, report)
         seconds["pictures"] = time.perf_counter() - t
         # After the pictures: culling spreads bodies around body 0 and takes them away again.
-        phase("cull", lambda: cull_gates(page, report))
+        phase("cull", lambda: cull_gates(page, report, ref.rig.body_scale))
         # Last: the grid replaces every body (instance 0 included) of the lab.
         phase("grid", lambda: grid_gates(page, ref, package, report))
         page.evaluate("() => window.__lab.finish()")
