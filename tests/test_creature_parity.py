@@ -379,7 +379,7 @@ def test_the_job_catches_a_spawn_that_spreads_bodies_over_pages(out_root: Path, 
 
 MOVED_GATE = "bodies deformed by a tick that moves every live body (pre-pass: all of them)"
 STILL_GATE = "bodies deformed by a frame in which no pose changed (pre-pass: only what moved)"
-PAUSE_GATE = "bodies deformed by a tick with one body paused, beyond the live bodies but that one"
+PAUSE_GATE = "bodies deformed by a tick with every body but one paused, beyond that one"
 SPAWN_GATE = "bodies deformed by a frame whose only change is one spawn beside still bodies (only what moved)"
 
 

@@ -422,6 +422,19 @@ async function main() {
       return out;
     },
     stagedPose(i = 0) { return Array.from(diag.stagedPose(i)); },
+    /**
+     * The largest distance between body i's drawn vertices (its deform storage) and the GPU body path run
+     * at its current pose by the diagnostics kernel: both read back here, only the number goes out.
+     */
+    async drawnGap(i = 0) {
+      const drawn = (await diag.readDeformed(i)).position;
+      const path = (await diag.readSkinned(i)).corrected;
+      let gap = 0;
+      for (let k = 0; k < drawn.length; k += 3) {
+        gap = Math.max(gap, Math.hypot(drawn[k] - path[k], drawn[k + 1] - path[k + 1], drawn[k + 2] - path[k + 2]));
+      }
+      return gap;
+    },
     async readSkinned(i = 0) {
       const r = await diag.readSkinned(i);
       return { skinned: toBase64(new Uint8Array(r.skinned.buffer)), corrected: toBase64(new Uint8Array(r.corrected.buffer)),
