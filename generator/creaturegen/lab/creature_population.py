@@ -138,10 +138,8 @@ def moved_gates(page: Page, report: ParityReport, telemetry: dict[str, Any]) -> 
         "bodies",
     )
     # Every body but body 0 paused: one tick deforms body 0 alone and leaves a paused body's rows alone.
-    count = int(page.evaluate("() => window.__lab.telemetry()")["count"])
-    held = list(range(1, count))
-    page.evaluate(f"() => window.__lab.pause({held})")
-    before = page.evaluate("() => window.__lab.stagedPose(1)")
+    held = page.evaluate("() => window.__lab.pauseAllBut([0])")
+    before = page.evaluate(f"() => window.__lab.stagedPose({held[0]})")
     page.evaluate("() => window.__lab.stepTicks(1)")
     deformed = page.evaluate("() => window.__lab.telemetry()")["stats"]["lastFrameDeformedBodies"]
     report.gate(
@@ -149,7 +147,7 @@ def moved_gates(page: Page, report: ParityReport, telemetry: dict[str, Any]) -> 
         abs(deformed - 1),
         0,
         "bodies",
-        passed=deformed == 1 and page.evaluate("() => window.__lab.stagedPose(1)") == before,
+        passed=deformed == 1 and page.evaluate(f"() => window.__lab.stagedPose({held[0]})") == before,
     )
     page.evaluate(f"() => window.__lab.resume({held})")
 

@@ -336,6 +336,12 @@ async function main() {
     /** Hold these instances still (population.pause), or step them on again. */
     pause(ids = [0]) { for (const id of ids) pop.pause(id); return ids; },
     resume(ids = [0]) { for (const id of ids) pop.resume(id); return ids; },
+    /** Pause every live body but `keep`; returns the ids paused. */
+    pauseAllBut(keep = [0]) {
+      const held = [];
+      for (let i = 0; i < pop.capacity; i++) if (pop.instance(i).alive && !keep.includes(i)) { pop.pause(i); held.push(i); }
+      return held;
+    },
     /** Flush (whatever changed since the last upload, culling included) and draw one frame. */
     redraw() { const bytes = pop.flush(); render(); return bytes; },
     /** Cull against body 0's portrait view as it stands now ('portrait'), the lab camera ('camera'), or nothing. */
