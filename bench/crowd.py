@@ -119,7 +119,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     folder: Path = args.package.resolve()
     ensure_package(folder, log)
     started = time.perf_counter()
-    with open_bench(folder, args, args.bodies, args.bodies) as (bench, _):
+    with open_bench(folder, args, args.bodies, args.bodies, variants=("shipped",)) as (bench, _):
         info = bench.info()
         log(f"  page ready in {time.perf_counter() - started:.1f} s; spawning {args.bodies}")
         population = bench.population(args.bodies)

@@ -314,11 +314,11 @@ def measure_spawns(bench: Bench, spawns: int) -> dict[str, Any]:
 
 @contextlib.contextmanager
 def open_bench(
-    folder: Path, args: argparse.Namespace, capacity: int, frame: int
+    folder: Path, args: argparse.Namespace, capacity: int, frame: int, variants: Sequence[str] = VARIANTS
 ) -> Iterator[tuple[Bench, LabPage]]:
     """The bench lab page on the package in ``folder`` (served with its parent as /out/): ``capacity``
     bodies in pages of ``args.page_size``, the views framing ``frame`` of them, ``args.canvas`` and
-    ``args.shadows``."""
+    ``args.shadows``, with the pre-pass ``variants`` built and compiled."""
     query = {
         "pkg": folder.name,
         "w": args.canvas[0],
@@ -328,6 +328,7 @@ def open_bench(
         "frame": frame,
         "shadows": 1 if args.shadows else 0,
         "fdStep": FD_STEP,
+        "variants": ",".join(variants),
     }
     with serve(WEB_LAB, mounts={"out": folder.parent}) as base_url:
         url = f"{base_url}creature-bench.html?{urlencode(query)}"

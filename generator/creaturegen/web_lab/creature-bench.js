@@ -20,6 +20,8 @@ const frameBodies = Number(params.get('frame') ?? capacity);
 const fdStep = Number(params.get('fdStep') ?? 1e-3);
 // The sun's shadow map (a second pass through every body's vertex path); on by default, as in the lab.
 const shadows = (params.get('shadows') ?? '1') !== '0';
+// The pre-pass variants to build and compile (the crowd bench times the shipped one only).
+const wanted = (params.get('variants') ?? 'shipped,baseline,lbs').split(',');
 const out = document.getElementById('out');
 
 // Draw calls and render passes, counted at the WebGPU encoders (what was submitted, not what three meant to).
@@ -103,12 +105,13 @@ async function main() {
 
   // Both variants' deform pre-passes, one per page, built before anything is timed. The material, the
   // storage and the draws are the package's own in both: only the field path in the pre-pass differs.
-  const kernels = {
-    shipped: pop.pages.map((p) => p.kernel),
-    baseline: pop.pages.map((p) => createBaselineKernel(tsl, layout, p, internals.records, internals.programs, step)),
+  const builders = {
+    shipped: () => pop.pages.map((p) => p.kernel),
+    baseline: () => pop.pages.map((p) => createBaselineKernel(tsl, layout, p, internals.records, internals.programs, step)),
     // What a SkinnedMesh does: linear blend skinning alone, no correction, no field (lab code too).
-    lbs: pop.pages.map((p) => createLbsKernel(tsl, layout, p, internals.records, internals.programs)),
+    lbs: () => pop.pages.map((p) => createLbsKernel(tsl, layout, p, internals.records, internals.programs)),
   };
+  const kernels = Object.fromEntries(wanted.map((v) => [v, builders[v]()]));
   let variant = 'shipped';
   function setVariant(v) {
     if (!(v in kernels)) throw new Error(`variant: shipped, baseline or lbs (got ${v})`);
@@ -142,7 +145,7 @@ async function main() {
   const t0 = performance.now();
   spawn(1, 1);
   const compileMs = {};
-  for (const v of ['shipped', 'baseline', 'lbs']) {
+  for (const v of wanted) {
     const start = performance.now();
     setVariant(v);
     console.log(`creature bench: compiling ${v}`);
