@@ -93,7 +93,7 @@ def test_a_lower_tier_package_passes_every_parity_gate(out_root: Path) -> None:
     ("swap", "gate"),
     [
         (
-            ("normal.assign(rotatedNormal(blend.br, n));", "normal.assign(n);"),
+            ("rotatedNormal(body.br, n)).toVar();", "n).toVar();"),
             "drawn normal of skin-program vertices vs numpy skinned normal",
         ),
         (
@@ -105,7 +105,7 @@ def test_a_lower_tier_package_passes_every_parity_gate(out_root: Path) -> None:
 def test_the_job_catches_a_wrong_skin_normal(
     out_root: Path, tmp_path: Path, swap: tuple[str, str], gate: str
 ) -> None:
-    """An unrotated DQ normal and an LBS cofactor out of order, in the shipped skin.js."""
+    """An unrotated DQ/CoR normal and an LBS cofactor out of order, in the shipped skin.js."""
     package = build_example("reference/hopper.json", out_root, "distant")
     planted = _planted(package, tmp_path, "skin.js", [swap])
     report = run_creature_parity(planted, groups=("skin",))

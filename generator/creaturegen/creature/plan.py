@@ -90,12 +90,12 @@ def _representation(field_vertices: int, vertices: int) -> str:
 
 
 def program_data(tapes: list[Tape]) -> list[float]:
-    """Headers (offset, count, 0, 0) per program, then every instruction (op, a, b, k), flat."""
+    """Headers (offset, count, leaves, 0) per program, then every instruction (op, a, b, k), flat."""
     headers: list[float] = []
     body: list[float] = []
     offset = len(tapes)
     for tape in tapes:
-        headers += [float(offset), float(len(tape)), 0.0, 0.0]
+        headers += [float(offset), float(len(tape)), float(tape.leaf_count), 0.0]
         for op, a, b, k in tape.instructions:
             body += [float(op), float(a), float(b), float(k)]
         offset += len(tape)

@@ -3,8 +3,9 @@
 A candidate program (or the full graph) is a small DAG of smooth-min ops over slot leaves. The GPU runs
 it as a straight list of instructions whose register ``i`` is the result of instruction ``i``, so one
 dynamic loop bounded by the program's own length evaluates it: no per-graph shader text, no masked
-full-budget unroll, and every region's program shares one pipeline. Each instruction is four floats
-``(op, a, b, k)`` (small integers are exact in float32):
+full-budget unroll, and every region's program shares one pipeline. The LEAF instructions lead the
+tape, so the runtime runs them in a loop of their own (the header carries their count). Each
+instruction is four floats ``(op, a, b, k)`` (small integers are exact in float32):
 
 - ``LEAF``  slot ``a``'s distance and gradient (a global slot index into the pose page);
 - ``POLY``  polynomial smooth-min of registers ``a`` (left) and ``b`` (right), width ``k``;
@@ -40,6 +41,11 @@ class Tape:
 
     def __len__(self) -> int:
         return len(self.instructions)
+
+    @property
+    def leaf_count(self) -> int:
+        """The LEAF instructions, which lead the tape (the runtime's header carries the count)."""
+        return len(self.leaves)
 
 
 def compile_tape(graph: BlendGraph, leaves: tuple[int, ...] | None = None) -> Tape:
@@ -77,7 +83,26 @@ def compile_tape(graph: BlendGraph, leaves: tuple[int, ...] | None = None) -> Ta
     if acc != len(code) - 1:  # a lone root evaluated earlier than the last instruction
         code.append((COPY, acc, 0, 0.0))
     leaf_order = tuple(order[i] for i in sorted(slot_register, key=slot_register.__getitem__))
-    return Tape(tuple(code), leaf_order)
+    return Tape(_leaves_first(code), leaf_order)
+
+
+def _leaves_first(code: list[tuple[int, int, int, float]]) -> tuple[tuple[int, int, int, float], ...]:
+    """``code`` with its LEAF instructions first, each group in its own order, operands renumbered.
+
+    The runtime then fills the leaf registers in one loop that runs only the slot formula and the blends in a
+    second that never does: a GPU lane (and SwiftShader's CPU lanes, which run every branch of an ``if`` under
+    a mask) otherwise pays for the slot formula at every blend instruction too. Every operand still names an
+    earlier register, an ``LSE``'s copies stay contiguous (no leaf sits between them) and the leaves keep
+    their order, so each register holds the same value and the colour sums run in the same order.
+    """
+    leaves = [i for i, ins in enumerate(code) if ins[0] == LEAF]
+    blends = [i for i, ins in enumerate(code) if ins[0] != LEAF]
+    moved = {old: new for new, old in enumerate(leaves + blends)}
+    out = [code[i] for i in leaves]
+    for i in blends:
+        op, a, b, k = code[i]
+        out.append((op, moved[a], b if op in (LSE, COPY) else moved[b], k))
+    return tuple(out)
 
 
 def _slot_count(graph: BlendGraph) -> int:

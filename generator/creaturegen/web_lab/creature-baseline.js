@@ -146,10 +146,10 @@ export function baselineFunctions(tsl, layout, pose, programs, step) {
  * storage, same material reading it) over the baseline functions. Swapping `page.kernel` between this and
  * the shipped kernel changes nothing but the field path.
  */
-export function createBaselineKernel(tsl, layout, page, records, programs, step) {
+export function createBaselineKernel(tsl, layout, page, records, order, programs, step) {
   const fns = baselineFunctions(tsl, layout, page.pose, programs, step);
   return tsl.createDeformKernel(layout, fns, {
-    pose: page.pose, records, deform: page.deform, list: page.list, size: page.size, vertices: layout.vertices,
+    pose: page.pose, records, order, deform: page.deform, list: page.list, size: page.size, vertices: layout.vertices,
   });
 }
 
@@ -184,5 +184,5 @@ export function createLbsKernel(tsl, layout, page, records, programs) {
     });
   })().compute(page.size * vertices);
   kernel.setName('cgDeformPlainLbs');
-  return { kernel, list: page.list, vertices, size: page.size };
+  return { kernels: [{ kernel, count: vertices }], list: page.list, vertices, size: page.size };
 }

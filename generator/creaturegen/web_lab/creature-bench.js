@@ -107,7 +107,7 @@ async function main() {
   // storage and the draws are the package's own in both: only the field path in the pre-pass differs.
   const builders = {
     shipped: () => pop.pages.map((p) => p.kernel),
-    baseline: () => pop.pages.map((p) => createBaselineKernel(tsl, layout, p, internals.records, internals.programs, step)),
+    baseline: () => pop.pages.map((p) => createBaselineKernel(tsl, layout, p, internals.records, internals.order, internals.programs, step)),
     // What a SkinnedMesh does: linear blend skinning alone, no correction, no field (lab code too).
     lbs: () => pop.pages.map((p) => createLbsKernel(tsl, layout, p, internals.records, internals.programs)),
   };

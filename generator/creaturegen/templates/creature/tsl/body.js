@@ -57,9 +57,12 @@ export function bodyFunctions(layout, pose, programs) {
  * distance and accepted are 0. Inputs are nodes so the vertex stage (attributes) and the diagnostics
  * kernels (storage) share it. `program` is the program the field runs (full for noProgram and
  * skinProgram), `code` the vertex's own candidate code as stored (skinProgram for a skin vertex).
+ * `path` (deform.js PATHS) builds one branch alone for a kernel that runs only vertices taking it:
+ * 'skin', 'field' (a vertex whose trust radius is 0, which the correction would leave as it is) or
+ * 'corrected'; 'any' chooses per vertex.
  */
 export function bodyVertex(layout, fns, {
-  rest, slots, weights, skin, cor, normal, colourSlots, colourWeights, base, skinOnly, colour = false,
+  rest, slots, weights, skin, cor, normal, colourSlots, colourWeights, base, skinOnly, colour = false, path = 'any',
 }) {
   const skinVertexOnly = skin.z.greaterThan(layout.skinProgram - 0.5).and(skin.z.lessThan(layout.skinProgram + 0.5)).toVar();
   const program = select(skin.z.greaterThan(layout.skinProgram - 0.5), int(layout.fullProgram), int(skin.z)).toVar();
@@ -70,16 +73,17 @@ export function bodyVertex(layout, fns, {
   const gradient = vec3(0).toVar();
   const distance = float(0).toVar();
   const albedo = colour ? vec3(0).toVar() : null;
-  If(skinVertexOnly, () => {
+  const skinPath = () => {
     // No field: the skinned position and rest normal (no correction: its trust radius is 0), baked colour.
     const body = fns.skin.skinVertexNormal(rest.mul(s), normal, base, slots, weights, skin.x, cor.mul(s));
     skinned.assign(body.position);
     position.assign(body.position);
     gradient.assign(body.normal);
     if (colour) albedo.assign(fns.field.bakedColour(base, colourSlots, colourWeights));
-  }).Else(() => {
+  };
+  const fieldPath = (correct) => {
     skinned.assign(fns.skin.skinVertex(rest.mul(s), base, slots, weights, skin.x, cor.mul(s)));
-    const corrected = skinOnly ? { position: skinned, accepted: float(0) } : fns.skin.correctVertex(skinned, base, program, skin.y.mul(s));
+    const corrected = skinOnly || !correct ? { position: skinned, accepted: float(0) } : fns.skin.correctVertex(skinned, base, program, skin.y.mul(s));
     // One evaluation at the final position: the normal's gradient, the distance and (display) the colour.
     const final = fns.field.evaluate(corrected.position, base, program, { colour, kFloor: layout.kFloor });
     position.assign(corrected.position);
@@ -87,7 +91,11 @@ export function bodyVertex(layout, fns, {
     gradient.assign(final.value.yzw);
     distance.assign(final.value.x);
     if (colour) albedo.assign(final.colour);
-  });
+  };
+  if (path === 'skin') skinPath();
+  else if (path === 'field') fieldPath(false);
+  else if (path === 'corrected') fieldPath(true);
+  else If(skinVertexOnly, skinPath).Else(() => fieldPath(true));
   const code = select(skinVertexOnly, float(layout.skinProgram), float(program));
   return { skinned, position, accepted, program, code, gradient, distance, colour: albedo };
 }

@@ -1,11 +1,11 @@
-// The deform pre-pass of a pose page: a compute kernel runs every vertex of every live body in a dirty
-// range through the body path once (skin, bounded correction, one field evaluation at the final
-// position) and stores what the passes draw. The display pass and the shadow pass then read the same
+// The deform pre-pass of a pose page: compute kernels (one per branch of the body path, vertexOrder) run
+// every vertex of every listed body through the body path once (skin, bounded correction, one field
+// evaluation at the final position) and store what the passes draw. The display pass and the shadow pass then read the same
 // stored position, so the shadow is cast by the very surface that is seen, and no vertex is skinned or
 // evaluated twice in a frame (a vertex stage would re-run the whole path per pass, and per re-shaded
 // vertex on a rasteriser without a post-transform cache, such as SwiftShader).
 import { Fn, If, instanceIndex, instancedArray, int, storage, vec4 } from 'three/tsl';
-import { bodyVertex } from './body.js';
+import { SKIN_PROGRAM, bodyVertex } from './body.js';
 
 /** vec4 per drawn vertex: (position, distance), (gradient, accepted), (albedo, program); creaturegen's
  * DEFORM_STRIDE (creature/plan.py), which the build report's deformBytesPerBody uses. A SKIN_PROGRAM
@@ -40,6 +40,45 @@ export function vertexRecords(geometry) {
   return instancedArray(out, 'vec4').toReadOnly();
 }
 
+/**
+ * The branch of the body path a vertex takes (bodyVertex `path`), in the order the pre-pass runs them:
+ * no field at all (SKIN_PROGRAM), the field without correction (trust radius 0), corrected.
+ */
+export const PATHS = Object.freeze(['skin', 'field', 'corrected']);
+
+/**
+ * The order the pre-pass runs a body's vertices in and its segments, one per path (empty ones left
+ * out): { order (one int per rest vertex, a permutation), segments: [{ path, start, count }] }. Within a
+ * segment vertices are grouped by program and skinning method, rest order last. Each segment is its own
+ * dispatch, compiled with only its path's code, and neighbouring invocations take the same branches: a
+ * GPU lane group pays for every branch any of its lanes takes, and SwiftShader runs every branch of an
+ * `if` under a mask, so in one kernel over the rest order a skin-only vertex paid for the field and the
+ * correction, and every vertex for the longest tape beside it. The order changes no vertex's result:
+ * each invocation writes its own vertex's slot of the deform storage.
+ */
+export function vertexOrder(geometry) {
+  const skin = geometry.attributes.cgSkin.array;
+  const n = geometry.attributes.position.count;
+  const pathOf = (v) => {
+    const program = skin[4 * v + 2];
+    if (program > SKIN_PROGRAM - 0.5 && program < SKIN_PROGRAM + 0.5) return 0;
+    return skin[4 * v + 1] > 0 ? 2 : 1;
+  };
+  const keys = Array.from({ length: n }, (_, v) => [pathOf(v), skin[4 * v + 2], skin[4 * v]]);
+  const order = Int32Array.from({ length: n }, (_, v) => v);
+  order.sort((a, b) => {
+    for (let c = 0; c < 3; c++) if (keys[a][c] !== keys[b][c]) return keys[a][c] - keys[b][c];
+    return a - b;
+  });
+  const segments = [];
+  for (let k = 0; k < n; k++) {
+    const path = PATHS[keys[order[k]][0]];
+    if (segments.length === 0 || segments[segments.length - 1].path !== path) segments.push({ path, start: k, count: 0 });
+    segments[segments.length - 1].count += 1;
+  }
+  return { order: instancedArray(order, 'int').toReadOnly(), segments };
+}
+
 /** The record of rest vertex `v` as the inputs bodyVertex takes. */
 export function recordInputs(records, v) {
   const r = v.mul(RECORD_STRIDE);
@@ -66,38 +105,47 @@ export function instanceList(size) {
 }
 
 /**
- * The deform kernel of one page over `fns` (bodyFunctions, or a lab baseline's). It runs the bodies named
- * by the first `count` entries of the page's instance `list` (dispatchDeform), each into its own slice of
- * the deform storage, so a body left out keeps what it stored last: the population lists only the bodies
- * whose pose rows changed since their last pre-pass. Dead instances are skipped (the vertex stage draws
- * them collapsed to the origin).
+ * The deform kernels of one page over `fns` (bodyFunctions, or a lab baseline's), one per segment of
+ * `order` (vertexOrder). They run the bodies named by the first `count` entries of the page's instance
+ * `list` (dispatchDeform), each into its own slice of the deform storage, so a body left out keeps what
+ * it stored last: the population lists only the bodies whose pose rows changed since their last
+ * pre-pass. Dead instances are skipped (the vertex stage draws them collapsed to the origin).
  */
-export function createDeformKernel(layout, fns, { pose, records, deform, list, size, vertices, skinOnly = false }) {
+export function createDeformKernel(layout, fns, { pose, records, order, deform, list, size, vertices, skinOnly = false }) {
   const rowsPerInstance = layout.maxParts * layout.rows;
-  const kernel = Fn(() => {
-    const entry = int(instanceIndex).div(vertices).toVar();
-    const v = int(instanceIndex).sub(entry.mul(vertices)).toVar();
-    const j = list.element(entry).toVar();
-    const idx = j.mul(vertices).add(v).toVar();
-    const base = j.mul(rowsPerInstance).toVar();
-    const alive = pose.element(base.add(layout.slotCount * layout.rows)).w;
-    If(alive.greaterThan(0.5), () => {
-      const body = bodyVertex(layout, fns, { ...recordInputs(records, v), base, skinOnly, colour: true });
-      const o = idx.mul(DEFORM_STRIDE).toVar();
-      deform.element(o).assign(vec4(body.position, body.distance));
-      deform.element(o.add(1)).assign(vec4(body.gradient, body.accepted));
-      deform.element(o.add(2)).assign(vec4(body.colour, body.code));
-    });
-  })().compute(size * vertices);
-  kernel.setName(skinOnly ? 'cgDeformSkinOnly' : 'cgDeform');
-  return { kernel, list, vertices, size };
+  const kernels = order.segments.map(({ path, start, count }) => {
+    const kernel = Fn(() => {
+      const entry = int(instanceIndex).div(count).toVar();
+      const v = order.order.element(int(instanceIndex).sub(entry.mul(count)).add(start)).toVar();
+      const j = list.element(entry).toVar();
+      const idx = j.mul(vertices).add(v).toVar();
+      const base = j.mul(rowsPerInstance).toVar();
+      const alive = pose.element(base.add(layout.slotCount * layout.rows)).w;
+      If(alive.greaterThan(0.5), () => {
+        const body = bodyVertex(layout, fns, { ...recordInputs(records, v), base, skinOnly, colour: true, path });
+        const o = idx.mul(DEFORM_STRIDE).toVar();
+        deform.element(o).assign(vec4(body.position, body.distance));
+        deform.element(o.add(1)).assign(vec4(body.gradient, body.accepted));
+        deform.element(o.add(2)).assign(vec4(body.colour, body.code));
+      });
+    })().compute(size * count);
+    kernel.setName(`${skinOnly ? 'cgDeformSkinOnly' : 'cgDeform'}.${path}`);
+    return { kernel, count };
+  });
+  return { kernels, list, vertices, size };
 }
 
-/** Run `deform` over the first `count` bodies of its page's instance list; returns the vertices processed. */
+/**
+ * Run `deform` (every segment's kernel) over the first `count` bodies of its page's instance list;
+ * returns the vertices processed.
+ */
 export function dispatchDeform(renderer, deform, count) {
-  const n = count * deform.vertices;
-  if (n <= 0) return 0;
-  deform.kernel.count = n;
-  renderer.compute(deform.kernel);
+  if (count <= 0) return 0;
+  let n = 0;
+  for (const segment of deform.kernels) {
+    segment.kernel.count = count * segment.count;
+    renderer.compute(segment.kernel);
+    n += segment.kernel.count;
+  }
   return n;
 }

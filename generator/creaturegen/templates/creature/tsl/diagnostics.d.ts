@@ -3,7 +3,7 @@
 import type { BufferGeometry, WebGPURenderer } from 'three/webgpu';
 import type { CreatureData } from '../core/index.js';
 import type { CreaturePopulation } from '../index.js';
-import type { Layout, PoseStorage } from './index.js';
+import type { Layout, PoseStorage, VertexOrder } from './index.js';
 
 // Only what is declared `export` below is public: without this, TypeScript exports every top-level
 // declaration of a declaration file.
@@ -28,6 +28,7 @@ export interface PopulationInternals {
   readonly programs: PoseStorage;
   readonly geometry: BufferGeometry;
   readonly records: PoseStorage;
+  readonly order: VertexOrder;
   locate(id: number): { page: object; index: number };
   stagedPose(id: number): Float32Array;
   variantKeys(): string[];

@@ -3,9 +3,11 @@
 // carried together (vec4: d, ∇d), so normals come from the analytic gradient of the very loop that
 // measures the distance: no finite differences.
 //
-// A program is a tape (creature/tape.py): instruction i = (op, a, b, k) writes register i. One dynamic
-// loop bounded by the program's own length runs it, so every candidate region shares one pipeline and
-// no vertex pays for slots outside its program.
+// A program is a tape (creature/tape.py): instruction i = (op, a, b, k) writes register i, the LEAF
+// instructions first. Two dynamic loops bounded by the program's own counts run it, the leaves (the slot
+// formula alone) and then the blends (never the slot formula: a lane runs every branch of an `if` it
+// cannot skip, and SwiftShader masks rather than skips), so every candidate region shares one pipeline
+// and no vertex pays for slots outside its program.
 import {
   Break, Fn, If, Loop, abs, array, clamp, exp, float, int, log, max, min, select, sqrt, vec3, vec4,
 } from 'three/tsl';
@@ -29,7 +31,7 @@ function perpendicular(axis) {
 /**
  * The field nodes of one pose layout. `pose` is a vec4 storage node holding `rows` vec4 per slot:
  * (a, ra), (b, rb), (k, rgb), quaternion, (t, roundCone). `programs` is a vec4 storage node: program
- * headers (offset, count, 0, 0) first, then instructions. `registers` bounds the register file (K).
+ * headers (offset, count, leaves, 0) first, then instructions, leaves leading. `registers` bounds the register file (K).
  */
 /** The size of the instance whose rows start at `base`: root row 1 .w (core/pose.js writeRootRows). */
 export function rootSize({ slotCount, rows }, pose, base) {
@@ -119,14 +121,16 @@ export function createField({ pose, programs, rows, slotCount, registers, gradie
     const header = programs.element(program);
     const offset = int(header.x).toVar();
     const count = int(header.y).toVar();
+    const leaves = int(header.z).toVar();
     const regs = array('vec4', registers).toVar();
-    Loop(count, ({ i }) => {
+    Loop(leaves, ({ i }) => {
+      regs.element(i).assign(slotField(p, base, int(programs.element(offset.add(i)).y)));
+    });
+    Loop({ start: leaves, end: count }, ({ i }) => {
       const ins = programs.element(offset.add(i)).toVar();
       const op = int(ins.x).toVar();
       const ia = int(ins.y), ib = int(ins.z), k = ins.w.mul(size);
-      If(op.equal(OP.LEAF), () => {
-        regs.element(i).assign(slotField(p, base, ia));
-      }).ElseIf(op.equal(OP.POLY), () => {
+      If(op.equal(OP.POLY), () => {
         regs.element(i).assign(poly(regs.element(ia), regs.element(ib), k));
       }).ElseIf(op.equal(OP.COPY), () => {
         regs.element(i).assign(regs.element(ia));
@@ -151,19 +155,14 @@ export function createField({ pose, programs, rows, slotCount, registers, gradie
     const value = regs.element(count.sub(1)).toVar();
     if (!colour) return { value, colour: null };
     const dMin = float(3.4e38).toVar();
-    Loop(count, ({ i }) => {
-      If(int(programs.element(offset.add(i)).x).equal(OP.LEAF), () => { dMin.assign(min(dMin, regs.element(i).x)); });
-    });
+    Loop(leaves, ({ i }) => { dMin.assign(min(dMin, regs.element(i).x)); });
     const sum = float(0).toVar();
     const rgb = vec3(0).toVar();
-    Loop(count, ({ i }) => {
-      const ins = programs.element(offset.add(i));
-      If(int(ins.x).equal(OP.LEAF), () => {
-        const row = colourRow(base, int(ins.y));
-        const w = exp(max(regs.element(i).x.sub(dMin), 0).negate().div(max(row.x, size.mul(kFloor))));
-        sum.addAssign(w);
-        rgb.addAssign(row.yzw.mul(w));
-      });
+    Loop(leaves, ({ i }) => {
+      const row = colourRow(base, int(programs.element(offset.add(i)).y));
+      const w = exp(max(regs.element(i).x.sub(dMin), 0).negate().div(max(row.x, size.mul(kFloor))));
+      sum.addAssign(w);
+      rgb.addAssign(row.yzw.mul(w));
     });
     return { value, colour: rgb.div(sum) };
   };

@@ -64,21 +64,29 @@ export const NO_PROGRAM: number;
 export const SKIN_PROGRAM: number;
 export function layoutOf(data: CreatureData): Layout;
 export function bodyFunctions(layout: Layout, pose: PoseStorage, programs: PoseStorage): BodyFunctions;
-export function bodyVertex(layout: Layout, fns: BodyFunctions, inputs: VertexInputs & { base: Node; skinOnly: boolean; colour?: boolean }): BodyVertex;
+export function bodyVertex(layout: Layout, fns: BodyFunctions, inputs: VertexInputs & { base: Node; skinOnly: boolean; colour?: boolean; path?: VertexPath | 'any' }): BodyVertex;
 
 /** vec4 per drawn vertex in a page's deform storage: (position, distance), (gradient, accepted), (albedo, program). */
 export const DEFORM_STRIDE: number;
 /** vec4 per rest vertex in the vertex records. */
 export const RECORD_STRIDE: number;
-export interface DeformKernel { kernel: ComputeNode; list: PoseStorage; vertices: number; size: number }
+/** One dispatch of the pre-pass: the vertices of one path (deform.js PATHS) of every listed body. */
+export interface DeformSegmentKernel { kernel: ComputeNode; count: number }
+export interface DeformKernel { kernels: DeformSegmentKernel[]; list: PoseStorage; vertices: number; size: number }
+/** The branch of the body path a vertex takes. */
+export type VertexPath = 'skin' | 'field' | 'corrected';
+export const PATHS: readonly VertexPath[];
+/** The order the pre-pass runs a body's vertices in and its segments, one per path. */
+export interface VertexOrder { order: PoseStorage; segments: { path: VertexPath; start: number; count: number }[] }
 export function vertexRecords(geometry: BufferGeometry): PoseStorage;
+export function vertexOrder(geometry: BufferGeometry): VertexOrder;
 export function recordInputs(records: PoseStorage, v: Node): VertexInputs;
 export function deformStorage(size: number, vertices: number): PoseStorage;
 export function deformView(deform: PoseStorage): PoseStorage;
 /** A page's instance list (one int per body): the bodies the next pre-pass runs. */
 export function instanceList(size: number): PoseStorage;
 export function createDeformKernel(layout: Layout, fns: BodyFunctions, options: {
-  pose: PoseStorage; records: PoseStorage; deform: PoseStorage; list: PoseStorage; size: number; vertices: number; skinOnly?: boolean;
+  pose: PoseStorage; records: PoseStorage; order: VertexOrder; deform: PoseStorage; list: PoseStorage; size: number; vertices: number; skinOnly?: boolean;
 }): DeformKernel;
 /** Run `deform` over the first `count` bodies of its page's instance list; returns the vertices processed. */
 export function dispatchDeform(renderer: WebGPURenderer, deform: DeformKernel, count: number): number;

@@ -5,7 +5,7 @@ export { METHOD, createSkin, rotate } from './skin.js';
 export { NO_PROGRAM, SKIN_PROGRAM, bodyFunctions, bodyVertex, layoutOf } from './body.js';
 export {
   DEFORM_STRIDE, RECORD_STRIDE, createDeformKernel, deformStorage, deformView, dispatchDeform, instanceList, recordInputs,
-  vertexRecords,
+  PATHS, vertexOrder, vertexRecords,
 } from './deform.js';
 export { DEBUG_MODES, checkDebugMode, createBodyMaterial, rootNormal, rootPoint, rootRotate } from './material.js';
 export { createShellMesh } from './shell.js';

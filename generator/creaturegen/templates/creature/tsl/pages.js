@@ -61,10 +61,10 @@ function materialFor(state, page, m) {
 
 function kernelFor(state, page, kind) {
   if (!page.kernels.has(kind)) {
-    const { layout, programs, records, vertices } = state;
+    const { layout, programs, records, order, vertices } = state;
     const fns = bodyFunctions(layout, page.pose, programs);
     page.kernels.set(kind, createDeformKernel(layout, fns, {
-      pose: page.pose, records, deform: page.deform, list: page.list, size: page.size, vertices, skinOnly: kind === 'skin-only',
+      pose: page.pose, records, order, deform: page.deform, list: page.list, size: page.size, vertices, skinOnly: kind === 'skin-only',
     }));
   }
   return page.kernels.get(kind);

@@ -17,7 +17,7 @@ import { POSE_ROWS } from '../core/pose.js';
 import { checkThreeRevision, loadSurface, resolveSurfaceUrl } from '../core/surface.js';
 import { defaultSurfaceUrl } from './asset.js';
 import { layoutOf } from './body.js';
-import { DEFORM_STRIDE, dispatchDeform, vertexRecords } from './deform.js';
+import { DEFORM_STRIDE, dispatchDeform, vertexOrder, vertexRecords } from './deform.js';
 import { registerInternals } from './internals.js';
 import { checkDebugMode } from './material.js';
 import { createPages, kernelKind, showMode } from './pages.js';
@@ -97,6 +97,7 @@ export async function createCreaturePopulation(renderer, options = {}) {
   const layout = layoutOf(data);
   const programs = programStorage(surface);
   const records = vertexRecords(geometry);
+  const order = vertexOrder(geometry);
   const vertices = layout.vertices;
   // A page's deform storage is one binding: it must fit the device's maxStorageBufferBindingSize.
   const deformBytesPerBody = vertices * DEFORM_STRIDE * 16;
@@ -111,7 +112,7 @@ export async function createCreaturePopulation(renderer, options = {}) {
   const group = new THREE.Group();
   group.name = data.slug;
   const state = {
-    renderer, data, capacity, pageSize, floatsPerInstance, layout, programs, records, vertices, geometry, group,
+    renderer, data, capacity, pageSize, floatsPerInstance, layout, programs, records, order, vertices, geometry, group,
     variants: new Map(),
     stats: {
       uploads: 0, uploadBytes: 0, lastFrameBytes: 0, spawns: 0, ticks: 0, deformDispatches: 0, lastFrameDeformedVertices: 0,
@@ -331,6 +332,8 @@ export async function createCreaturePopulation(renderer, options = {}) {
     data, layout, programs, geometry,
     /** The rest-vertex records (deform.js) every page's pre-pass reads. */
     records,
+    /** The order every page's pre-pass runs a body's vertices in (deform.js vertexOrder). */
+    order,
     /** The page holding instance `id` and its index there. */
     locate(id) {
       const { page, j } = locate(state, id);

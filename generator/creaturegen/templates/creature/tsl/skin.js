@@ -100,14 +100,25 @@ export function createSkin({ pose, rows, field, correction }) {
   // deform.skin_dq / skin_cor's normal: the blended (normalised) rotation of the position's own blend.
   const rotatedNormal = (br, n) => normalize(rotate(br, n));
 
+  // Every method's position from one blend of the influences: LBS at the vertex (LBS) or at its centre of
+  // rotation (CoR's translation), one hemisphere-aligned quaternion blend (DQ's real and dual parts, CoR's
+  // rotation), each formula's own operations in its own order, so each method's result is the one lbs, dq
+  // and cor give. One pass instead of three: a lane group runs every method any of its lanes uses, and
+  // SwiftShader every branch of an `if`, so three branches cost three blends for each vertex.
+  const skinMethods = (v, base, slots, weights, method, centre) => {
+    const isLbs = method.lessThan(0.5).toVar();
+    const isDq = method.lessThan(1.5).toVar();
+    const linear = lbs(select(isLbs, v, centre), base, slots, weights).toVar();
+    const { real, dual } = blendQuats(base, slots, weights, true);
+    const norm = sqrt(dot4(real, real));
+    const br = real.div(norm).toVar();
+    const viaDq = dqApply({ br, bd: dual.div(norm) }, v);
+    const viaCor = rotate(br, v.sub(centre)).add(linear);
+    return { isLbs, isDq, br, position: select(isLbs, linear, select(isDq, viaDq, viaCor)) };
+  };
+
   /** The skinned (uncorrected) position of one vertex; `method` is its joint's choice (0, 1, 2). */
-  const skinVertex = Fn(([v, base, slots, weights, method, centre]) => {
-    const out = vec3(0).toVar();
-    If(method.lessThan(0.5), () => { out.assign(lbs(v, base, slots, weights)); })
-      .ElseIf(method.lessThan(1.5), () => { out.assign(dq(v, base, slots, weights)); })
-      .Else(() => { out.assign(cor(v, base, slots, weights, centre)); });
-    return out;
-  });
+  const skinVertex = Fn(([v, base, slots, weights, method, centre]) => skinMethods(v, base, slots, weights, method, centre).position);
 
   /**
    * The skinned position and the skinned rest normal `n` of one vertex (a vertex that evaluates no field),
@@ -115,20 +126,9 @@ export function createSkin({ pose, rows, field, correction }) {
    * Inline (call it inside a Fn): returns { position, normal } nodes.
    */
   const skinVertexNormal = (v, n, base, slots, weights, method, centre) => {
-    const position = vec3(0).toVar();
-    const normal = vec3(0).toVar();
-    If(method.lessThan(0.5), () => {
-      position.assign(lbs(v, base, slots, weights));
-      normal.assign(lbsNormal(n, base, slots, weights));
-    }).ElseIf(method.lessThan(1.5), () => {
-      const blend = dqBlend(base, slots, weights);
-      position.assign(dqApply(blend, v));
-      normal.assign(rotatedNormal(blend.br, n));
-    }).Else(() => {
-      const br = corRotation(base, slots, weights);
-      position.assign(corApply(br, v, base, slots, weights, centre));
-      normal.assign(rotatedNormal(br, n));
-    });
+    const body = skinMethods(v, base, slots, weights, method, centre);
+    const position = body.position.toVar();
+    const normal = select(body.isLbs, lbsNormal(n, base, slots, weights), rotatedNormal(body.br, n)).toVar();
     return { position, normal };
   };
 

@@ -173,7 +173,7 @@ export function refreshDrawn(state, page) {
 
 /**
  * The pre-pass over the page's drawn bodies that moved since their last pre-pass: their indices written
- * into the page's instance list (uploaded with the dispatch), one dispatch. A moved body that is culled
+ * into the page's instance list (uploaded with the dispatch), one dispatch per path (deform.js vertexOrder). A moved body that is culled
  * keeps its flag and is deformed when a view sees it again. Returns the vertices processed.
  */
 export function deformMoved(state, page) {
@@ -187,7 +187,7 @@ export function deformMoved(state, page) {
   state.stats.lastFrameDeformedBodies += n;
   if (n === 0) return 0;
   markRange(page.list.value, page.ranges.list, 0, n);
-  state.stats.deformDispatches += 1;
+  state.stats.deformDispatches += page.kernel.kernels.length;
   return dispatchDeform(state.renderer, page.kernel, n);
 }
 

@@ -6,9 +6,9 @@
 // step never hand one creature another's mesh; core/surface.js checks the signatures either way.
 
 /** The .glb's file name (also CREATURE.surfaceFile): what to copy next to `assetBase`. */
-export const SURFACE_FILE = "hopper-squash-core-4ad943085362.glb";
+export const SURFACE_FILE = "hopper-squash-core-09a117dd9d71.glb";
 
 /** The package's own copy of the surface, resolved against this module. */
 export function defaultSurfaceUrl() {
-  return new URL("../assets/hopper-squash-core-4ad943085362.glb", import.meta.url).href;
+  return new URL("../assets/hopper-squash-core-09a117dd9d71.glb", import.meta.url).href;
 }
