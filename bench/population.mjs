@@ -115,7 +115,9 @@ async function allocations(names) {
 
 const result = {
   package: data.slug, type: data.motion.type, tickRate: data.tickRate, slots: data.slotCount, bodies: options.bodies,
-  pageSize: pop.pageSize, pages: pop.pages.length, node: process.version, v8Flags: process.execArgv, options,
+  pageSize: pop.pageSize, pages: pop.pages.length,
+  // One dispatch per vertex path of the body (tsl/deform.js vertexOrder) per page whose bodies moved.
+  deformKernelsPerPage: pop.pages[0].kernel.kernels.length, node: process.version, v8Flags: process.execArgv, options,
   scenarios: Object.fromEntries(Object.keys(scenarios).map((name) => [name, cost(name)])),
   allocation: await allocations(options.allocScenarios ?? ['moving', 'culled-half-paused']),
 };

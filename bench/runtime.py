@@ -360,6 +360,10 @@ def run_package(folder: Path, args: argparse.Namespace, log: Callable[[str], Non
         log(f"  spawn cost ({args.spawns} spawns)")
         spawn = measure_spawns(bench, args.spawns)
         errors = bench.gpu_errors()
+        if errors:
+            # A kernel that failed to compile runs nothing: every time beside it is meaningless.
+            log(f"  WARNING: {len(errors)} WebGPU errors, this package's figures are not valid:")
+            log(f"  {errors[0][:300]}")
 
     slots, registers = int(info["slots"]), int(info["registers"])
     counts = [p["bodies"] for p in populations]

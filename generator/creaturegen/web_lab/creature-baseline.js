@@ -142,15 +142,19 @@ export function baselineFunctions(tsl, layout, pose, programs, step) {
 }
 
 /**
- * The baseline deform pre-pass of one page: the package's own createDeformKernel (same dispatch, same
+ * The baseline deform pre-pass of one page: the package's own createDeformKernel (same dispatches, same
  * storage, same material reading it) over the baseline functions. Swapping `page.kernel` between this and
- * the shipped kernel changes nothing but the field path.
+ * the shipped kernel changes nothing but the field path. Each vertex path's kernel gets baseline functions
+ * of its own: the distance function has a WGSL layout (cgBaselineDistance), and a layout function node
+ * shared by two compute nodes is declared only in the first one's shader (three r185), so the second
+ * fails to compile ("unresolved value NodeBuffer_…").
  */
 export function createBaselineKernel(tsl, layout, page, records, order, programs, step) {
-  const fns = baselineFunctions(tsl, layout, page.pose, programs, step);
-  return tsl.createDeformKernel(layout, fns, {
-    pose: page.pose, records, order, deform: page.deform, list: page.list, size: page.size, vertices: layout.vertices,
-  });
+  const kernels = order.segments.flatMap((segment) => tsl.createDeformKernel(layout, baselineFunctions(tsl, layout, page.pose, programs, step), {
+    pose: page.pose, records, order: { order: order.order, segments: [segment] }, deform: page.deform, list: page.list, size: page.size,
+    vertices: layout.vertices,
+  }).kernels);
+  return { kernels, list: page.list, vertices: layout.vertices, size: page.size };
 }
 
 /**

@@ -9,6 +9,7 @@ import { bodyFunctions } from './body.js';
 import { createDeformKernel, deformStorage, deformView, instanceList } from './deform.js';
 import { createBodyMaterial } from './material.js';
 import { createShellMesh } from './shell.js';
+import { uploadRange } from './staging.js';
 
 /** Allocate every page of `state` (capacity bodies in pages of state.pageSize) and add their meshes. */
 export function createPages(state) {
@@ -35,8 +36,8 @@ export function createPages(state) {
       // The bodies the passes draw (drawList, its CPU copy `drawn`: live and, when the population culls,
       // seen by one of its views), in instance order; mesh.count is how many.
       drawList, drawn: drawList.value.array, culled: 0,
-      // One reusable update range per uploaded attribute (staging.js markRange).
-      ranges: { pose: { start: 0, count: 0 }, list: { start: 0, count: 0 }, drawList: { start: 0, count: 0 } },
+      // One reusable update range per uploaded attribute (staging.js uploadRange, markRange).
+      ranges: { pose: uploadRange(pose.value), list: uploadRange(list.value), drawList: uploadRange(drawList.value) },
       alive: new Uint8Array(size), paused: new Uint8Array(size), seed: new Uint32Array(size), spawnTick: new Float64Array(size),
       motions: new Array(size).fill(null), bounds: new Float64Array(6 * size),
       genomes: new Float64Array(GENOME_LENGTH * size), colours: new Float64Array(3 * data.slotCount * size),

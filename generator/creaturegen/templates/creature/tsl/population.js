@@ -125,8 +125,8 @@ export async function createCreaturePopulation(renderer, options = {}) {
       tmp: new Float64Array(3), localBox: new Float64Array(6), corner: new THREE.Vector3(), box: new THREE.Box3(),
       previous: new Float32Array(floatsPerInstance), matrix: new THREE.Matrix4(),
     },
-    // The views the population culls against (cullWith) and their frusta, refreshed at every flush.
-    views: [], frusta: [], planes: new Float64Array(0), groupMatrix: new Float64Array(16), viewsChanged: false,
+    // The views the population culls against (cullWith) and their frustum planes, refreshed at every flush.
+    views: [], planes: new Float64Array(0), groupMatrix: new Float64Array(16), viewsChanged: false,
     tick: 0,
     mode: checkDebugMode(options.debugMode ?? 'off'),
   };
@@ -296,7 +296,6 @@ export async function createCreaturePopulation(renderer, options = {}) {
         if (!usable) throw new Error(`cullWith: cameras or shadow-casting lights (got ${view?.type ?? view})`);
       }
       state.views = views;
-      state.frusta = views.map(() => new THREE.Frustum());
       state.planes = new Float64Array(24 * views.length);
       state.viewsChanged = true;
     },

@@ -4,6 +4,7 @@
 // the drawn bodies whose rows changed since their last pre-pass (a body standing still, e.g. a hopper
 // between hops or a frame with no step and the same interpolation, keeps its stored surface; a culled
 // body is neither deformed nor drawn). All in place: the steady frame loop allocates nothing.
+import { WebGLCoordinateSystem, WebGPUCoordinateSystem } from 'three/webgpu';
 import { rootBounds, writePoseRows, writeRootRows } from '../core/pose.js';
 import { dispatchDeform } from './deform.js';
 
@@ -57,6 +58,38 @@ export function advance(state, n) {
   state.stats.ticks += n;
 }
 
+// Plane k of a view at planes[o + 4k ..]: (x, y, z, w) divided by |(x, y, z)|, as three's Plane
+// setComponents(x, y, z, w).normalize() computes it.
+function setPlane(planes, o, k, x, y, z, w) {
+  const inverseLength = 1.0 / Math.sqrt(x * x + y * y + z * z);
+  const p = o + 4 * k;
+  planes[p] = x * inverseLength;
+  planes[p + 1] = y * inverseLength;
+  planes[p + 2] = z * inverseLength;
+  planes[p + 3] = w * inverseLength;
+}
+
+/**
+ * The six planes of the frustum of the view-projection matrix `me` (its elements) into planes[o .. o + 24):
+ * three's Frustum.setFromProjectionMatrix, formula for formula, written into a Float64Array instead of
+ * Plane objects (whose double fields V8 boxes anew on every store: 140 B per frame and view).
+ */
+function frustumPlanes(me, coordinateSystem, reversedDepth, planes, o) {
+  setPlane(planes, o, 0, me[3] - me[0], me[7] - me[4], me[11] - me[8], me[15] - me[12]);
+  setPlane(planes, o, 1, me[3] + me[0], me[7] + me[4], me[11] + me[8], me[15] + me[12]);
+  setPlane(planes, o, 2, me[3] + me[1], me[7] + me[5], me[11] + me[9], me[15] + me[13]);
+  setPlane(planes, o, 3, me[3] - me[1], me[7] - me[5], me[11] - me[9], me[15] - me[13]);
+  if (reversedDepth) {
+    setPlane(planes, o, 4, me[2], me[6], me[10], me[14]);
+    setPlane(planes, o, 5, me[3] - me[2], me[7] - me[6], me[11] - me[10], me[15] - me[14]);
+  } else {
+    setPlane(planes, o, 4, me[3] - me[2], me[7] - me[6], me[11] - me[10], me[15] - me[14]);
+    if (coordinateSystem === WebGLCoordinateSystem) setPlane(planes, o, 5, me[3] + me[2], me[7] + me[6], me[11] + me[10], me[15] + me[14]);
+    else if (coordinateSystem === WebGPUCoordinateSystem) setPlane(planes, o, 5, me[2], me[6], me[10], me[14]);
+    else throw new Error(`cullWith: a camera with an unknown coordinate system (${coordinateSystem})`);
+  }
+}
+
 /**
  * The population's culling views for this flush: each camera's frustum (a shadow-casting light's shadow
  * camera, its matrices brought up to date first) as six planes in `state.planes`, and the group's world
@@ -65,7 +98,7 @@ export function advance(state, n) {
  * steady loop allocates nothing.
  */
 export function updateViews(state) {
-  const { views, frusta, planes, groupMatrix, scratch } = state;
+  const { views, planes, groupMatrix, scratch } = state;
   state.group.updateWorldMatrix(true, false);
   groupMatrix.set(state.group.matrixWorld.elements);
   for (let i = 0; i < views.length; i++) {
@@ -79,15 +112,7 @@ export function updateViews(state) {
       camera.updateMatrixWorld();
     }
     scratch.matrix.multiplyMatrices(camera.projectionMatrix, camera.matrixWorldInverse);
-    frusta[i].setFromProjectionMatrix(scratch.matrix, camera.coordinateSystem, camera.reversedDepth);
-    for (let k = 0; k < 6; k++) {
-      const plane = frusta[i].planes[k];
-      const o = 24 * i + 4 * k;
-      planes[o] = plane.normal.x;
-      planes[o + 1] = plane.normal.y;
-      planes[o + 2] = plane.normal.z;
-      planes[o + 3] = plane.constant;
-    }
+    frustumPlanes(scratch.matrix.elements, camera.coordinateSystem, camera.reversedDepth, planes, 24 * i);
   }
 }
 
@@ -123,22 +148,35 @@ function seen(state, page, j) {
 }
 
 /**
- * Mark `count` elements from `start` of a storage attribute for the next upload through one reusable range
- * object (`range`): merged with a pending upload of the same range instead of allocating another (three's
- * addUpdateRange allocates one per call; its backend consumes the ranges when it uploads).
+ * The one update range of a storage attribute the population uploads (pose rows, instance and draw lists),
+ * reused for the attribute's life: its `updateRanges` become a fixed one-entry list that three's backend
+ * reads as it reads the array (length, then [i]) and its `clearUpdateRanges` only sets the length back to
+ * 0. three's own pair allocates every frame: addUpdateRange a range object per call, and clearUpdateRanges
+ * sets the array's length to 0, on which V8 drops the array's backing store, so the next push allocates
+ * another (1.5 kB per frame for 16 pages). Returns the range object.
+ */
+export function uploadRange(attribute) {
+  const range = { start: 0, count: 0 };
+  const list = { length: 0, 0: range };
+  attribute.updateRanges = list;
+  attribute.clearUpdateRanges = () => { list.length = 0; };
+  return range;
+}
+
+/**
+ * Mark `count` elements from `start` of an attribute set up by uploadRange for the next upload: its one
+ * range, merged with a pending upload (the span of both).
  */
 function markRange(attribute, range, start, count) {
   const ranges = attribute.updateRanges;
   if (ranges.length === 0) {
     range.start = start;
     range.count = count;
-    ranges.push(range);
-  } else if (ranges.length === 1 && ranges[0] === range) {
+    ranges.length = 1;
+  } else {
     const end = Math.max(range.start + range.count, start + count);
     range.start = Math.min(range.start, start);
     range.count = end - range.start;
-  } else {
-    attribute.addUpdateRange(start, count);
   }
   attribute.needsUpdate = true;
 }

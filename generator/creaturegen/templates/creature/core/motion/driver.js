@@ -8,21 +8,22 @@ export const MAX_ACCUMULATOR_S = 0.25;
 
 export function createDriver(hz) {
   const step = 1 / hz;
-  let accumulator = 0;
-  let alpha = 0;
+  // (accumulator, alpha) in a Float64Array: a double stored into a closure variable is boxed anew on
+  // every store, and the driver runs once per frame.
+  const s = new Float64Array(2);
   return {
     hz, step,
-    get accumulator() { return accumulator; },
-    get alpha() { return alpha; },
+    get accumulator() { return s[0]; },
+    get alpha() { return s[1]; },
     /** Whole fixed steps due after a frame of `dt` seconds (the caller runs them, then renders at alpha). */
     advance(dt) {
       const clamped = dt > 0 ? Math.min(dt, MAX_FRAME_S) : 0;
-      accumulator = Math.min(accumulator + clamped, MAX_ACCUMULATOR_S);
+      s[0] = Math.min(s[0] + clamped, MAX_ACCUMULATOR_S);
       let steps = 0;
-      while (accumulator >= step) { accumulator -= step; steps += 1; }
-      alpha = accumulator / step;
+      while (s[0] >= step) { s[0] -= step; steps += 1; }
+      s[1] = s[0] / step;
       return steps;
     },
-    reset() { accumulator = 0; alpha = 0; },
+    reset() { s[0] = 0; s[1] = 0; },
   };
 }
