@@ -101,10 +101,19 @@ function cost(name) {
   };
 }
 
+// Windows of N and of 3N frames: what the frames allocate grows with N, what the probe itself costs a
+// window (its closures, the memory reading) does not, so the difference of the cleanest windows over 2N
+// frames is the steady loop's own rate.
 async function allocation(name) {
   scenarios[name]();
-  const best = await allocationWindows((n) => frames(n, null), { warm: options.allocWarm, window: options.allocFrames, rounds: options.allocRounds });
-  return { scenario: name, frames: options.allocFrames, bytesPerFrame: best.heapGrowthBytes / options.allocFrames, ...best };
+  const n = options.allocFrames;
+  const run = (k) => frames(k, null);
+  const best = await allocationWindows(run, { warm: options.allocWarm, window: n, rounds: options.allocRounds });
+  const long = await allocationWindows(run, { warm: 0, window: 3 * n, rounds: options.allocRounds });
+  return {
+    scenario: name, frames: n, bytesPerFrame: (long.heapGrowthBytes - best.heapGrowthBytes) / (2 * n), ...best,
+    long: { frames: 3 * n, ...long },
+  };
 }
 
 async function allocations(names) {

@@ -12,8 +12,10 @@ pages of ``--page-size`` on a grid. Measured in this run:
   other body paused; culled to a top-down camera that sees ``--in-view`` of the bodies, all moving; and
   culled with half paused;
 * **allocation**: V8 heap growth and the garbage collections a ``gc`` PerformanceObserver saw start inside
-  windows of ``--alloc-frames`` frames, each after a full collection, after a warm-up (the cleanest of
-  five windows reported, all beside it), for the moving and the culled-half-paused scenarios. Node runs
+  windows of ``--alloc-frames`` frames and of three times as many, each after a full collection, after a
+  warm-up (the cleanest of five windows of each length reported, all beside it), for the moving and the
+  culled-half-paused scenarios; bytes per frame are the growth of the long window less the short one's
+  over the frames between them (the probe's own per-window cost cancels). Node runs
   with ``--no-concurrent-recompilation`` (as bench/motion.py).
 
 The JSON's ``targets``: no collection and no heap growth per frame in the steady loop.
@@ -88,7 +90,7 @@ def main(argv: Sequence[str] | None = None) -> int:
             "name": f"garbage collections in a window of {w['frames']} frames ({w['scenario']})",
             "value": w["collections"],
             "target": 0,
-            "met": w["collections"] == 0,
+            "met": w["collections"] == 0 and w["long"]["collections"] == 0,
         }
         for w in result["allocation"]
     ] + [
@@ -96,7 +98,7 @@ def main(argv: Sequence[str] | None = None) -> int:
             "name": f"heap growth per frame ({w['scenario']}), bytes",
             "value": w["bytesPerFrame"],
             "target": 0,
-            "met": w["collections"] == 0 and w["heapGrowthBytes"] <= 0,
+            "met": w["collections"] == 0 and w["long"]["collections"] == 0 and w["bytesPerFrame"] <= 0,
         }
         for w in result["allocation"]
     ]

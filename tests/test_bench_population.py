@@ -41,6 +41,7 @@ def test_population_benchmark_smoke(creature_out: Path, tmp_path: Path) -> None:
         assert scenario["usPerBodyPerFrame"]["p50"] > 0
         assert scenario["dispatchesPerFrame"] <= report["deformKernelsPerPage"] * BODIES // PAGE_SIZE
     assert {w["scenario"] for w in report["allocation"]} == {"moving", "culled-half-paused"}
-    assert all(len(w["windows"]) == 5 for w in report["allocation"])
+    assert all(len(w["windows"]) == len(w["long"]["windows"]) == 5 for w in report["allocation"])
+    assert all(w["long"]["frames"] == 3 * w["frames"] for w in report["allocation"])
     assert len(report["targets"]) == 4
     assert all(isinstance(t["met"], bool) for t in report["targets"])
