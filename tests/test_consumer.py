@@ -35,9 +35,11 @@ from typing import Any
 import numpy as np
 import pytest
 
+from conftest import shared_folder
 from creaturegen.emit.packsize import npm_json
 from creaturegen.lab.browser import launch_lab_page
 from creaturegen.lab.server import serve
+from creaturegen.surface.cache import exclusive
 
 REPO = Path(__file__).resolve().parent.parent
 CONSUMER = REPO / "tests" / "consumer"
@@ -88,17 +90,26 @@ class Consumer:
     env: dict[str, str]
 
 
+def _wheel(factory: pytest.TempPathFactory) -> Path:
+    """The tool's wheel, built once per run: ``pip wheel`` of the checkout builds in its ``build/`` folder,
+    and two xdist workers building there at once break each other's build ("could not delete")."""
+    folder = shared_folder(factory, "consumer-wheel")
+    with exclusive(folder / ".lock"):
+        found = sorted(folder.glob("creaturegen-*.whl"))
+        if not found:
+            pip = [sys.executable, "-m", "pip", "wheel", "--no-deps", "--quiet"]
+            _run([*pip, "-w", str(folder), str(REPO)], folder)
+            found = sorted(folder.glob("creaturegen-*.whl"))
+    return found[0]
+
+
 @pytest.fixture(scope="module")
 def consumer(tmp_path_factory: pytest.TempPathFactory) -> Consumer:
     """Wheel → fresh venv → builds → npm pack → fresh project with the tarballs, esbuild and Vite bundles."""
     work = tmp_path_factory.mktemp("consumer")
     env = {k: v for k, v in os.environ.items() if k not in ("VIRTUAL_ENV", "PYTHONPATH")}
     env["CREATUREGEN_PICTURE"] = "auto"  # as a user has it: the build says why it cannot draw the picture
-    _run(
-        [sys.executable, "-m", "pip", "wheel", "--no-deps", "--quiet", "-w", str(work / "wheel"), str(REPO)],
-        work,
-    )
-    wheel = next((work / "wheel").glob("creaturegen-*.whl"))
+    wheel = _wheel(tmp_path_factory)
     _run([sys.executable, "-m", "venv", str(work / "venv")], work)
     pip = work / "venv" / "bin" / "pip"
     _run([str(pip), "install", "--quiet", "--disable-pip-version-check", str(wheel)], work, env)

@@ -56,6 +56,8 @@ async function creatureMasks(renderer, pkg, target) {
   population.spawn({ seed: 1, position: [0, 0, 0] });
   population.seekTick(TICKS[0]);
   const camera = framing(population.instance(0).bounds);
+  // Culled as an app culls (the camera and the sun's shadow camera): a body in view draws as before.
+  population.cullWith(camera, sun);
   await population.warm(scene, camera);
   const masks = [];
   for (const tick of TICKS) {

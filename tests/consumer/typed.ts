@@ -19,7 +19,13 @@ export async function typed(renderer: THREE.WebGPURenderer, scene: THREE.Scene, 
   const quadrupeds = await createQuadrupeds(renderer, { capacity: 2 });
   const id: number = hoppers.spawn({ seed: 7, position: [0, 0, 0] });
   quadrupeds.spawn({ seed: 1 });
+  const sun = new THREE.DirectionalLight(0xffffff, 1);
+  hoppers.cullWith(camera, sun);
+  hoppers.pause(id);
+  hoppers.resume(id);
   const steps: number = hoppers.update(1 / 60);
+  const drawn: number = hoppers.stats.lastFrameDrawnBodies + hoppers.stats.lastFrameCulledBodies;
+  hoppers.cullWith();
   hoppers.setDebugMode(DEBUG_MODES[0]);
   const diagnostics = createDiagnostics(renderer, hoppers);
   const pose: Float32Array = await diagnostics.readPose(id);
@@ -29,5 +35,5 @@ export async function typed(renderer: THREE.WebGPURenderer, scene: THREE.Scene, 
   const frost = await createFrostEffect(renderer, scene, camera);
   frost.update(0, 1 / 60);
   frost.render();
-  return steps + pose.length + staged.length + slug.length + (motion ? 1 : 0);
+  return steps + drawn + pose.length + staged.length + slug.length + (motion ? 1 : 0);
 }
