@@ -145,9 +145,9 @@ export function baselineFunctions(tsl, layout, pose, programs, step) {
  * The baseline deform pre-pass of one page: the package's own createDeformKernel (same dispatches, same
  * storage, same material reading it) over the baseline functions. Swapping `page.kernel` between this and
  * the shipped kernel changes nothing but the field path. Each vertex path's kernel gets baseline functions
- * of its own: the distance function has a WGSL layout (cgBaselineDistance), and a layout function node
- * shared by two compute nodes is declared only in the first one's shader (three r185), so the second
- * fails to compile ("unresolved value NodeBuffer_…").
+ * of its own: the distance function has a WGSL layout (cgBaselineDistance), and with one such function
+ * node shared by two compute nodes of a page the second kernel's shader failed to compile here ("unresolved
+ * value NodeBuffer_…", three r185 on SwiftShader).
  */
 export function createBaselineKernel(tsl, layout, page, records, order, programs, step) {
   const kernels = order.segments.flatMap((segment) => tsl.createDeformKernel(layout, baselineFunctions(tsl, layout, page.pose, programs, step), {

@@ -1,7 +1,7 @@
 // The deform pre-pass of a pose page: compute kernels (one per branch of the body path, vertexOrder) run
 // every vertex of every listed body through the body path once (skin, bounded correction, one field
-// evaluation at the final position) and store what the passes draw. The display pass and the shadow pass then read the same
-// stored position, so the shadow is cast by the very surface that is seen, and no vertex is skinned or
+// evaluation at the final position) and store what the passes draw. The display pass and the shadow pass
+// then read the same stored position, so the shadow is cast by the very surface that is seen, and no vertex is skinned or
 // evaluated twice in a frame (a vertex stage would re-run the whole path per pass, and per re-shaded
 // vertex on a rasteriser without a post-transform cache, such as SwiftShader).
 import { Fn, If, instanceIndex, instancedArray, int, storage, vec4 } from 'three/tsl';

@@ -44,8 +44,6 @@ export interface BodySkin {
   lbsNormal(n: Node, base: Node, slots: Node, weights: Node): Node;
   correctVertex(p0: Node, base: Node, program: Node, trust: Node): { position: Node; accepted: Node };
   lbs(v: Node, base: Node, slots: Node, weights: Node): Node;
-  dq(v: Node, base: Node, slots: Node, weights: Node): Node;
-  cor(v: Node, base: Node, slots: Node, weights: Node, centre: Node): Node;
 }
 export function createSkin(options: { pose: PoseStorage; rows: number; field: BodyField; correction: Layout['correction'] }): BodySkin;
 /** R(q)·v on nodes (q xyzw). */

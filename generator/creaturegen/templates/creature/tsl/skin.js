@@ -43,8 +43,9 @@ export function createSkin({ pose, rows, field, correction }) {
     return v.add(acc);
   };
 
-  // The dominant influence (largest weight, first on ties) and every influence's hemisphere sign.
-  const blendQuats = (base, slots, weights, withDual) => {
+  // The hemisphere-aligned blend of the influences' rotations (real) and, for DQ, of their dual parts: the
+  // dominant influence (largest weight, first on ties) sets every influence's hemisphere sign.
+  const blendQuats = (base, slots, weights) => {
     const dom = int(slots.x).toVar();
     const best = weights.x.toVar();
     for (let c = 1; c < 4; c++) {
@@ -58,31 +59,17 @@ export function createSkin({ pose, rows, field, correction }) {
       const q = quat(base, s).toVar();
       const sw = select(dot4(q, ref).lessThan(0), weights.element(c).negate(), weights.element(c));
       real.addAssign(q.mul(sw));
-      if (withDual) dual.addAssign(qmul(vec4(shift(base, s), 0), q).mul(sw.mul(0.5)));
+      dual.addAssign(qmul(vec4(shift(base, s), 0), q).mul(sw.mul(0.5)));
     }
     return { real, dual };
   };
 
-  // DQ, as the reference's skin_dq: normalised blended dual quaternion (real part br, dual part bd).
-  const dqBlend = (base, slots, weights) => {
-    const { real, dual } = blendQuats(base, slots, weights, true);
-    const norm = sqrt(dot4(real, real));
-    return { br: real.div(norm).toVar(), bd: dual.div(norm) };
-  };
+  // DQ, as the reference's skin_dq: the normalised blended dual quaternion (real part br, dual part bd) applied to v.
   const dqApply = ({ br, bd }, v) => {
     const conj = vec4(br.xyz.negate(), br.w);
     const translation = qmul(bd, conj).xyz.mul(2);
     return rotate(br, v).add(translation);
   };
-  const dq = (v, base, slots, weights) => dqApply(dqBlend(base, slots, weights), v);
-
-  // CoR, as the reference's skin_cor: v' = R(v − p*) + LBS(p*), R the normalised blend of the hemisphere-aligned rotations.
-  const corRotation = (base, slots, weights) => {
-    const { real } = blendQuats(base, slots, weights, false);
-    return real.div(sqrt(dot4(real, real))).toVar();
-  };
-  const corApply = (br, v, base, slots, weights, centre) => rotate(br, v.sub(centre)).add(lbs(centre, base, slots, weights));
-  const cor = (v, base, slots, weights, centre) => corApply(corRotation(base, slots, weights), v, base, slots, weights, centre);
 
   // deform.skin_lbs's normal: cofactor(M)·n = det(M)·M⁻ᵀn, M = Σ wᵢRᵢ by its columns cₖ = Σ wᵢRᵢeₖ, so
   // n₀(c₁×c₂) + n₁(c₂×c₀) + n₂(c₀×c₁), normalised.
@@ -102,14 +89,15 @@ export function createSkin({ pose, rows, field, correction }) {
 
   // Every method's position from one blend of the influences: LBS at the vertex (LBS) or at its centre of
   // rotation (CoR's translation), one hemisphere-aligned quaternion blend (DQ's real and dual parts, CoR's
-  // rotation), each formula's own operations in its own order, so each method's result is the one lbs, dq
-  // and cor give. One pass instead of three: a lane group runs every method any of its lanes uses, and
-  // SwiftShader every branch of an `if`, so three branches cost three blends for each vertex.
+  // rotation), each formula's own operations in its own order: skin_lbs, skin_dq and skin_cor
+  // (surface/skinning.py), CoR as v' = R(v − p*) + LBS(p*). One pass instead of three: a lane group runs
+  // every method any of its lanes uses, and SwiftShader every branch of an `if`, so three branches cost
+  // three blends for each vertex.
   const skinMethods = (v, base, slots, weights, method, centre) => {
     const isLbs = method.lessThan(0.5).toVar();
     const isDq = method.lessThan(1.5).toVar();
     const linear = lbs(select(isLbs, v, centre), base, slots, weights).toVar();
-    const { real, dual } = blendQuats(base, slots, weights, true);
+    const { real, dual } = blendQuats(base, slots, weights);
     const norm = sqrt(dot4(real, real));
     const br = real.div(norm).toVar();
     const viaDq = dqApply({ br, bd: dual.div(norm) }, v);
@@ -175,6 +163,6 @@ export function createSkin({ pose, rows, field, correction }) {
     return { position: out, accepted };
   };
 
-  return { skinVertex, skinVertexNormal, correctVertex, lbs, dq, cor, lbsNormal };
+  return { skinVertex, skinVertexNormal, correctVertex, lbs, lbsNormal };
 }
 
