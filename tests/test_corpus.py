@@ -17,8 +17,9 @@ from pathlib import Path
 
 import pytest
 
+from creaturegen.batch.task import parse_refusal
 from creaturegen.corpus.random import LOCOMOTION_WEIGHTS, PART_RANGE, SCALE_RANGE, random_creature
-from creaturegen.corpus.run import parse_refusal, run_corpus
+from creaturegen.corpus.run import run_corpus
 from creaturegen.spec import CharacterSpec, validate_bytes
 
 BASELINE = Path(__file__).parent / "corpus-baseline.json"

@@ -1,7 +1,7 @@
 """Import layering (issue 26): the packages of creaturegen in the order the data flows, each importing
 only from its own layer or below. spec → model (slot layout, blend graph, poses and rotations,
 skeleton, LCG and genome) → field → rig → motion → candidates → surface → creature (and frost) → lab →
-corpus → cli. Every import statement counts, at module level or inside a function, so a cycle cannot
+batch → corpus → cli. Every import statement counts, at module level or inside a function, so a cycle cannot
 come back through a lazy import."""
 
 from __future__ import annotations
@@ -23,8 +23,11 @@ LAYERS: tuple[frozenset[str], ...] = (
     frozenset({"surface"}),
     frozenset({"creature", "frost"}),
     frozenset({"lab"}),
+    frozenset({"batch"}),
     frozenset({"corpus"}),
-    frozenset({"cli", "cli_args", "cli_build", "cli_commands", "cli_errors", "cli_report", "__main__"}),
+    frozenset(
+        {"cli", "cli_args", "cli_batch", "cli_build", "cli_commands", "cli_errors", "cli_report", "__main__"}
+    ),
 )
 LEVEL = {name: i for i, layer in enumerate(LAYERS) for name in layer}
 

@@ -9,6 +9,7 @@ import os
 
 from . import __version__
 from .candidates import DEFAULT_TIER, TIERS
+from .cli_batch import add_build_many
 from .cli_build import build_command
 from .cli_commands import (
     inspect_command,
@@ -47,6 +48,7 @@ def build_parser() -> argparse.ArgumentParser:
     _add_probe(commands)
     _add_inspect(commands)
     _add_build(commands)
+    add_build_many(commands)
     _add_parity(commands)
     _add_random(commands)
     _add_lab(commands)

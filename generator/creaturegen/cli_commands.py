@@ -159,7 +159,7 @@ def inspect_command(args: argparse.Namespace) -> int:
     return EXIT_OK
 
 
-def _lab_missing() -> str | None:
+def lab_missing() -> str | None:
     """Why the lab cannot run from this install (Playwright absent, three not installable), else None."""
     from .resources import MissingResourceError, lab_modules, playwright_missing
 
@@ -173,7 +173,7 @@ def _lab_missing() -> str | None:
 
 
 def parity_command(args: argparse.Namespace) -> int:
-    missing = _lab_missing()
+    missing = lab_missing()
     if missing is not None:
         print(f"creaturegen parity: {missing}", file=sys.stderr)
         return EXIT_INVALID

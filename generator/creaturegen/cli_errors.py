@@ -9,24 +9,14 @@ formed but its geometry cannot be certified, so the creature's shape (not its sy
 
 from __future__ import annotations
 
-import re
 import sys
 
-from .spec import SpecError
+from .spec import SpecError, format_error
 
 EXIT_OK = 0
 EXIT_GATE_FAILED = 1
 EXIT_INVALID = 2
 EXIT_REFUSED = 3
-
-_LINE_COLUMN = re.compile(r"^\d+:\d+$")
-
-
-def format_error(source: str, error: SpecError) -> str:
-    """``file: part.body.r: message``, or compiler style ``file:3:14: message`` for JSON syntax."""
-    if _LINE_COLUMN.match(error.path):
-        return f"{source}:{error.path}: {error.message}"
-    return f"{source}: {error.path}: {error.message}"
 
 
 def print_errors(source: str, errors: list[SpecError]) -> None:

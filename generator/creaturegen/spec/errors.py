@@ -7,6 +7,7 @@ Specs are often written by an AI from a prompt, so an error must say *where* (``
 from __future__ import annotations
 
 import json
+import re
 from dataclasses import dataclass
 
 #: Place used for problems with the document as a whole (size, top-level type).
@@ -25,6 +26,16 @@ class SpecError:
 
     def as_dict(self) -> dict[str, str]:
         return {"path": self.path, "message": self.message}
+
+
+_LINE_COLUMN = re.compile(r"^\d+:\d+$")
+
+
+def format_error(source: str, error: SpecError) -> str:
+    """``file: part.body.r: message``, or compiler style ``file:3:14: message`` for JSON syntax."""
+    if _LINE_COLUMN.match(error.path):
+        return f"{source}:{error.path}: {error.message}"
+    return f"{source}: {error.path}: {error.message}"
 
 
 class SpecValidationError(Exception):

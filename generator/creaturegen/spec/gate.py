@@ -174,9 +174,9 @@ def validate_bytes(data: bytes, source: str = "<spec>") -> Spec:
     raise SpecValidationError(errors, source)
 
 
-def load_spec(path: Path) -> Spec:
-    """Read and validate a spec file: a regular file, read no further than one byte past the limit (a
-    device such as /dev/zero would otherwise be read without end, a FIFO nobody writes would hang)."""
+def read_spec_bytes(path: Path) -> bytes:
+    """A spec file's bytes: a regular file, read no further than one byte past the limit (a device such as
+    /dev/zero would otherwise be read without end, a FIFO nobody writes would hang)."""
     try:
         info = path.stat()
         if not stat.S_ISREG(info.st_mode):
@@ -185,9 +185,13 @@ def load_spec(path: Path) -> Spec:
             message = f"is {info.st_size} bytes; specs are limited to {MAX_SPEC_BYTES} bytes"
             raise SpecValidationError([SpecError(WHOLE_SPEC, message)], str(path))
         with path.open("rb") as handle:
-            data = handle.read(MAX_SPEC_BYTES + 1)
+            return handle.read(MAX_SPEC_BYTES + 1)
     except OSError as exc:
         raise SpecValidationError(
             [SpecError(WHOLE_SPEC, f"cannot be read: {exc.strerror or exc}")], str(path)
         ) from exc
-    return validate_bytes(data, str(path))
+
+
+def load_spec(path: Path) -> Spec:
+    """Read (read_spec_bytes) and validate a spec file."""
+    return validate_bytes(read_spec_bytes(path), str(path))
