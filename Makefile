@@ -39,11 +39,12 @@ FUZZ_BUILDS ?= 50
 # Only folders that exist: git does not keep empty ones, and ruff fails on a missing path.
 LINT_PATHS := $(wildcard generator tests bench)
 
-.PHONY: help setup system-deps build parity corpus fuzz test schemas lab bench golden clean distclean
+.PHONY: help setup system-deps build bestiary parity corpus fuzz test schemas lab bench golden clean distclean
 
 help:
 	@echo "make setup    .venv + pip install -e '.[dev]', npm ci in $(WEB_LAB), chromium + lavapipe"
 	@echo "make build    creaturegen build \$$EXAMPLE (now $(EXAMPLE)) into out/"
+	@echo "make bestiary build-many every example at every tier (and its parity job): out/bestiary/index.html"
 	@echo "make parity   build every frost and creature example and run its parity job (out/<slug>/parity/)"
 	@echo "make corpus   build $(CORPUS_COUNT) generated creatures at $(CORPUS_TIERS): out/corpus/report.json, index.html"
 	@echo "make fuzz     $(FUZZ_CASES) hostile/mutated specs through the gate + $(FUZZ_BUILDS) real builds: out/fuzz/report.json"
@@ -56,7 +57,8 @@ help:
 	@echo "              surface.json (narrow band vs dense, numpy vs wgpu, extraction, gates),"
 	@echo "              runtime.json (creature frame p50/p95 vs bodies, per-body cost, baseline vs 7P/K, spawns),"
 	@echo "              motion.json (locomotion core in Node: µs per creature per step, rope cost, allocation),"
-	@echo "              validate.json (the spec gate on the worst shapes up to the 1 MiB limit)"
+	@echo "              validate.json (the spec gate on the worst shapes up to the 1 MiB limit),"
+	@echo "              batch.json (build-many: 1 and 2 workers, Dask, cache hit rate on a rebuild, parity stage)"
 	@echo "make clean    remove build output and caches; distclean also removes .venv and node_modules"
 
 # --- setup ------------------------------------------------------------------------------------
@@ -89,6 +91,10 @@ setup: $(VENV_STAMP) $(NODE_STAMP) system-deps
 build: setup
 	@echo "==> creaturegen build $(EXAMPLE)"
 	$(VENV)/bin/creaturegen build $(EXAMPLE)
+
+# Every example at every tier through build-many, with the parity jobs: out/bestiary/index.json and a gallery.
+bestiary: setup
+	$(VENV)/bin/creaturegen build-many examples -o out/bestiary --parity
 
 SLUG_OF := $(VENV_PY) -c 'import json, sys; from creaturegen.spec import slugify; print(slugify(json.load(open(sys.argv[1]))["name"]))'
 
@@ -132,6 +138,8 @@ bench: setup
 	$(VENV_PY) bench/validate.py --out bench/results/validate.json
 	@echo "==> motion benchmark (locomotion core in Node: cost per step, rope cost, allocation) into bench/results/motion.json"
 	$(VENV_PY) bench/motion.py --out bench/results/motion.json
+	@echo "==> batch benchmark (build-many: 1 and 2 workers, Dask, rebuild, resume, parity stage) into bench/results/batch.json"
+	$(VENV_PY) bench/batch.py --out bench/results/batch.json
 
 # --- checks -----------------------------------------------------------------------------------
 

@@ -229,3 +229,35 @@ def missing_setup(reason: str) -> None:
     if os.environ.get(STRICT_ENV) == "1":
         pytest.fail(f"{reason} (make test needs it: run `make setup`)")
     pytest.skip(reason)
+
+
+def gallery_shows_every_card(page_path: Path, cards: int, invalid: int = 0) -> None:
+    """The gallery from disk in Chromium: every card visible, its pictures loaded, filtering and
+    sorting by the page's own controls."""
+    from playwright.sync_api import sync_playwright
+
+    from creaturegen.lab.browser import find_chromium
+
+    with sync_playwright() as playwright:
+        browser = playwright.chromium.launch(executable_path=find_chromium(playwright), args=["--no-sandbox"])
+        try:
+            page = browser.new_page()
+            errors: list[str] = []
+            page.on("pageerror", lambda e: errors.append(str(e)))
+            page.goto(page_path.as_uri())
+            assert page.locator(".card:not(.hidden)").count() == cards
+            images = page.locator(".card img")
+            for i in range(images.count()):
+                assert images.nth(i).evaluate("img => img.complete && img.naturalWidth > 0")
+            assert page.inner_text("#shown") == f"{cards} of {cards} shown"
+            page.select_option("#status", "invalid")
+            assert page.locator(".card:not(.hidden)").count() == invalid
+            page.select_option("#status", "all")
+            page.fill("#filter", "zz-no-such-creature")
+            assert page.locator(".card:not(.hidden)").count() == 0
+            page.fill("#filter", "")
+            page.select_option("#sort", "seconds")
+            assert page.locator(".card:not(.hidden)").count() == cards
+            assert not errors, errors
+        finally:
+            browser.close()

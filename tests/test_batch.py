@@ -16,8 +16,8 @@ from pathlib import Path
 
 import psutil
 import pytest
-from conftest import REPO
 
+from conftest import REPO, gallery_shows_every_card
 from creaturegen.batch.results import job_key, next_step
 from creaturegen.batch.specs import BatchInputError, load_batch, spec_files
 from creaturegen.batch.task import pack, unpack
@@ -66,7 +66,7 @@ def test_specs_get_unique_ids_and_folders_are_searched(tmp_path: Path) -> None:
     with pytest.raises(BatchInputError, match="no such file"):
         spec_files([str(tmp_path / "missing")])
     (tmp_path / "empty").mkdir()
-    with pytest.raises(BatchInputError, match="no .json"):
+    with pytest.raises(BatchInputError, match=r"no \.json"):
         spec_files([str(tmp_path / "empty")])
 
 
@@ -108,7 +108,8 @@ def test_a_local_batch_records_every_outcome_and_a_rerun_skips_it(tmp_path: Path
     hopper = outcome[("hopper-squash-core", "hero")]
     assert hopper["workload"]["vertices"] > 0
     assert hopper["signatures"]["compilerSignature"]
-    assert "invalid" in first.stdout and "wrote" in first.stdout
+    assert "invalid" in first.stdout
+    assert "wrote" in first.stdout
     # Again: every job is done, nothing runs; then one package is removed and only it is built again.
     again = _build_many(str(specs), "-o", str(out), "--tiers", "hero")
     assert again.returncode == 0, again.stderr[-3000:]
@@ -119,39 +120,7 @@ def test_a_local_batch_records_every_outcome_and_a_rerun_skips_it(tmp_path: Path
     assert third.returncode == 0, third.stderr[-3000:]
     run = _index(out)["run"]
     assert (run["ran"], run["skipped"], run["surfaceCacheHits"]) == (1, 2, 1)  # type: ignore[index]
-    _gallery_shows_every_card(out / "index.html", 4, invalid=1)
-
-
-def _gallery_shows_every_card(page_path: Path, cards: int, invalid: int = 0) -> None:
-    """The gallery from disk in Chromium: every card visible, its pictures loaded, filtering and
-    sorting by the page's own controls."""
-    from playwright.sync_api import sync_playwright
-
-    from creaturegen.lab.browser import find_chromium
-
-    with sync_playwright() as playwright:
-        browser = playwright.chromium.launch(executable_path=find_chromium(playwright), args=["--no-sandbox"])
-        try:
-            page = browser.new_page()
-            errors: list[str] = []
-            page.on("pageerror", lambda e: errors.append(str(e)))
-            page.goto(page_path.as_uri())
-            assert page.locator(".card:not(.hidden)").count() == cards
-            images = page.locator(".card img")
-            for i in range(images.count()):
-                assert images.nth(i).evaluate("img => img.complete && img.naturalWidth > 0")
-            assert page.inner_text("#shown") == f"{cards} of {cards} shown"
-            page.select_option("#status", "invalid")
-            assert page.locator(".card:not(.hidden)").count() == invalid
-            page.select_option("#status", "all")
-            page.fill("#filter", "zz-no-such-creature")
-            assert page.locator(".card:not(.hidden)").count() == 0
-            page.fill("#filter", "")
-            page.select_option("#sort", "seconds")
-            assert page.locator(".card:not(.hidden)").count() == cards
-            assert not errors, errors
-        finally:
-            browser.close()
+    gallery_shows_every_card(out / "index.html", 4, invalid=1)
 
 
 def _build_children(parent: psutil.Process) -> list[psutil.Process]:
@@ -242,11 +211,13 @@ def test_a_dask_cluster_builds_runs_parity_on_the_chromium_worker_and_survives_a
         assert victim is not None, "no worker started a build"
         time.sleep(0.5)
         os.kill(pids[victim], signal.SIGKILL)
+        killed = pids[victim]
         stdout, stderr = batch.communicate(timeout=600)
     finally:
         if batch.poll() is None:
             batch.kill()
     assert batch.returncode == 0, stdout[-3000:] + stderr[-3000:]
+    assert not psutil.pid_exists(killed) or psutil.Process(killed).status() == psutil.STATUS_ZOMBIE
     index = _index(out)
     assert index["run"]["engine"] == "dask"  # type: ignore[index]
     assert index["run"]["transfer"] == "bytes"  # type: ignore[index]

@@ -17,6 +17,7 @@ from pathlib import Path
 
 import pytest
 
+from conftest import gallery_shows_every_card
 from creaturegen.batch.task import parse_refusal
 from creaturegen.corpus.random import LOCOMOTION_WEIGHTS, PART_RANGE, SCALE_RANGE, random_creature
 from creaturegen.corpus.run import run_corpus
@@ -114,8 +115,10 @@ def test_refusal_messages_are_parsed_into_gate_value_and_parts() -> None:
     assert parsed["parts"] == ["eye-left", "head"]
 
 
+@pytest.mark.browser
 def test_the_corpus_subset_holds_its_recorded_outcomes(tmp_path: Path) -> None:
-    """Hero and distant builds of the first seeds, each in its own process with a cold cache."""
+    """Hero and distant builds of the first seeds, each in its own process with a cold cache, through
+    build-many; its gallery opened in Chromium shows every card."""
     report = run_corpus(tmp_path, SUBSET_SEEDS, SUBSET_TIERS, jobs=1)
     baseline = json.loads(BASELINE.read_text())
     outcome = {(r["spec"], r["tier"]): r for r in report["results"]}
@@ -140,6 +143,7 @@ def test_the_corpus_subset_holds_its_recorded_outcomes(tmp_path: Path) -> None:
         built = sum(1 for r in report["results"] if r["tier"] == tier and r["status"] == "built")
         assert summary["built"] == built
         assert summary["specs"] == len(SUBSET_SEEDS)
+    gallery_shows_every_card(tmp_path / "index.html", len(SUBSET_SEEDS))
     pictures = list((tmp_path / "pictures").glob("*.png"))
     assert len(pictures) == sum(
         any(outcome[(f"seed-{s:05d}.json", t)]["status"] == "built" for t in SUBSET_TIERS)

@@ -377,6 +377,17 @@ def test_the_job_catches_a_spawn_that_spreads_bodies_over_pages(out_root: Path, 
     assert f"pose pages in use after {SPAWNS} spawns of pageSize {PAGE_SIZE}" in failed, report.summary()
 
 
+def test_the_moved_gates_expect_nothing_of_a_still_creature(out_root: Path) -> None:
+    """A creature without locomotion (corpus seed 2) stands still in the Python reference, so its tick
+    deforms no body already deformed; a hopper moves every tick. build-many's parity jobs over generated
+    creatures found the gates expecting every tick to move body 0."""
+    from creaturegen.creature.reference import load_reference
+    from creaturegen.lab.creature_population import moves_every_tick
+
+    assert not moves_every_tick(load_reference(build("fixtures/still-creature.json", out_root)))
+    assert moves_every_tick(load_reference(build("reference/hopper.json", out_root)))
+
+
 MOVED_GATE = "bodies deformed by a tick that moves every live body (pre-pass: all of them)"
 STILL_GATE = "bodies deformed by a frame in which no pose changed (pre-pass: only what moved)"
 PAUSE_GATE = "bodies deformed by a tick with every body but one paused, beyond that one"

@@ -100,7 +100,12 @@ def _tier_line(record: dict[str, Any], kind: str) -> str:
         return f'<div class="tier no" title="{title}">{_e(text)} — {shown}</div>'
     notes = []
     if record.get("posedFailed"):
-        notes.append("posed skin: " + ", ".join(g.removeprefix("posed.") for g in record["posedFailed"]))
+        parts = record.get("posedParts") or {}
+        gates = [
+            g.removeprefix("posed.") + (f" ({', '.join(parts[g])})" if parts.get(g) else "")
+            for g in record["posedFailed"]
+        ]
+        notes.append("posed skin: " + ", ".join(gates))
     parity = record.get("parity")
     if parity:
         failed = parity.get("failed") or []
@@ -140,6 +145,8 @@ def _card(spec_id: str, info: dict[str, Any], rows: list[dict[str, Any]]) -> str
             str(info.get("name", "")),
             *meta,
             *(f"{r.get('gate', '')} {' '.join(r.get('parts', []))}" for r in rows),
+            *(part for r in rows for parts in (r.get("posedParts") or {}).values() for part in parts),
+            *(g for r in rows for g in r.get("posedFailed", [])),
         ]
     ).lower()
     data = {
@@ -151,7 +158,9 @@ def _card(spec_id: str, info: dict[str, Any], rows: list[dict[str, Any]]) -> str
         "text": searchable,
     }
     attributes = " ".join(f'data-{k}="{_e(v)}"' for k, v in data.items())
-    lines = "".join(_tier_line(r, kind) for r in rows)
+    # An invalid spec was refused once, before any tier: one line says why.
+    shown = [{**rows[0], "tier": "spec"}] if kind == "invalid" and rows else rows
+    lines = "".join(_tier_line(r, kind) for r in shown)
     head = f'<div class="name">{_e(info.get("name", spec_id))}</div>'
     head += f'<div class="meta">{_e(" · ".join(meta))}</div>'
     return f'<div class="card" id="{_e(spec_id)}" {attributes}>{image}{head}{lines}</div>'

@@ -13,7 +13,7 @@ import queue
 import shutil
 import sys
 import time
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -80,19 +80,25 @@ def _jobs(specs: list[BatchSpec], options: BatchOptions) -> list[_Job]:
     return out
 
 
-def _invalid(job: _Job) -> dict[str, Any]:
-    """The record of a spec the gate refused (on the client: once, not once per worker)."""
+def _record(job: _Job, status: str, code: int, message: str) -> dict[str, Any]:
+    """A record the client writes itself (no task ran to the end)."""
     return {
         "spec": Path(job.spec.path).name,
         "id": job.spec.id,
         "tier": job.tier,
-        "status": "invalid",
-        "exitCode": 2,
+        "status": status,
+        "exitCode": code,
         "seconds": 0.0,
-        "message": job.spec.errors[0] if job.spec.errors else "",
-        "errors": list(job.spec.errors[:20]),
+        "message": message,
         "parts": [],
     }
+
+
+def _invalid(job: _Job) -> dict[str, Any]:
+    """The record of a spec the gate refused (on the client: once, not once per worker)."""
+    record = _record(job, "invalid", 2, job.spec.errors[0] if job.spec.errors else "")
+    record["errors"] = list(job.spec.errors[:20])
+    return record
 
 
 class _Batch:
@@ -169,23 +175,21 @@ class _Batch:
             record["package"] = str(folder.relative_to(self.out))
         return record
 
+    def _retried(self, job: _Job, result: TaskResult | None, again: Callable[[_Job], None]) -> bool:
+        """Run a lost task again while it has attempts left (True when it was resubmitted)."""
+        lost = result is None or result.record["status"] == LOST
+        if lost and job.attempts < self.options.attempts:
+            again(job)
+            return True
+        return False
+
     def on_build(self, job: _Job, future: TaskFuture) -> bool:
         """True when the job is over (False: it was resubmitted or went on to parity)."""
         result = self._result(job, future)
-        lost = result is None or result.record["status"] == LOST
-        if lost and job.attempts < self.options.attempts:
-            self.build(job)
+        if self._retried(job, result, self.build):
             return False
         if result is None:
-            job.record = {
-                "spec": Path(job.spec.path).name,
-                "id": job.spec.id,
-                "tier": job.tier,
-                "status": LOST,
-                "exitCode": -1,
-                "message": f"the worker was lost {job.attempts} times",
-                "parts": [],
-            }
+            job.record = _record(job, LOST, -1, f"the worker was lost {job.attempts} times")
             return True
         job.record = self._land(job, result)
         job.record["attempts"] = job.attempts
@@ -198,9 +202,7 @@ class _Batch:
     def on_parity(self, job: _Job, future: TaskFuture) -> bool:
         assert job.record is not None
         result = self._result(job, future)
-        lost = result is None or result.record["status"] == LOST
-        if lost and job.attempts < self.options.attempts:
-            self.parity(job)
+        if self._retried(job, result, self.parity):
             return False
         if result is None:
             job.record["parity"] = {"status": LOST, "message": f"lost {job.attempts} times"}

@@ -48,6 +48,7 @@ from .creature_population import (
     counter_gates,
     cull_gates,
     grid_gates,
+    moves_every_tick,
 )
 from .creature_pose import hash_gate, motion_gates, pose_and_field_gates
 from .creature_skin import skin_gates
@@ -87,7 +88,8 @@ def run_creature_parity(
                 run()
                 seconds[name] = time.perf_counter() - t
 
-        phase("population", lambda: counter_gates(page, report))
+        moving = moves_every_tick(ref)
+        phase("population", lambda: counter_gates(page, report, moving))
         phase("hash", lambda: hash_gate(page, report))
         page.evaluate(f"() => window.__lab.seekTick({PARITY_TICK})")
         phase("field", lambda: pose_and_field_gates(page, ref, motion, report))
@@ -98,7 +100,7 @@ def run_creature_parity(
         pictures(page, package, debug_pictures, report)
         seconds["pictures"] = time.perf_counter() - t
         # After the pictures: culling spreads bodies around body 0 and takes them away again.
-        phase("cull", lambda: cull_gates(page, report, ref.rig.body_scale))
+        phase("cull", lambda: cull_gates(page, report, ref.rig.body_scale, moving))
         # Last: the grid replaces every body (instance 0 included) of the lab.
         phase("grid", lambda: grid_gates(page, ref, package, report))
         page.evaluate("() => window.__lab.finish()")

@@ -11,13 +11,14 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
+import numpy.typing as npt
 from playwright.sync_api import Page
 
 from ..creature import reference as cref
 from ..creature.pose import POSE_ROWS, pose_rows, root_rows
 from ..model import layout as col
 from ..model.genome import slot_lab
-from .creature_lab import rgba_image
+from .creature_lab import LAB_POSITION, LAB_SEED, PARITY_TICK, rgba_image
 from .creature_skin import POSITION_TOL
 from .png import write_png
 from .report import ParityReport
@@ -56,7 +57,25 @@ CULL_SPACING = 6.0
 COLOUR_TOL = 0.0
 
 
-def counter_gates(page: Page, report: ParityReport) -> None:
+def _reference_rows(ref: cref.PackageReference, tick: int) -> npt.NDArray[np.float64]:
+    motion = cref.instance_motion(ref, LAB_SEED, tick, LAB_POSITION)
+    colours = cref.instance_colours(ref, LAB_SEED)
+    rows = pose_rows(ref.rig, motion.quats, motion.trans, colours, motion.size).reshape(-1)
+    return np.concatenate([rows, root_rows(motion.root, size=motion.size).reshape(-1)])
+
+
+def moves_every_tick(ref: cref.PackageReference) -> bool:
+    """Whether the Python locomotion reference changes body 0's pose rows from one tick to the next (at the
+    first tick and at the parity tick). A creature without locomotion stands still: after a body's first
+    pre-pass the population has nothing to deform again, and the "only what moved" gates expect exactly
+    that (found by build-many's parity jobs over generated creatures: they expected every tick to move
+    body 0)."""
+    return any(
+        not np.array_equal(_reference_rows(ref, t), _reference_rows(ref, t + 1)) for t in (0, PARITY_TICK)
+    )
+
+
+def counter_gates(page: Page, report: ParityReport, moving: bool = True) -> None:
     page.evaluate("() => window.__lab.resetCounters()")
     # Spawn without drawing, then one tick and one frame of all of them: a pipeline built at draw time
     # would show up here too.
@@ -95,8 +114,9 @@ def counter_gates(page: Page, report: ParityReport) -> None:
         "passes",
         passed=len(body_passes) >= 2,
     )
-    moved_gates(page, report, telemetry)
+    moved_gates(page, report, telemetry, moving)
     report.measurements["population"] = {
+        "bodyZeroMovesEveryTick": moving,
         "count": telemetry["count"],
         "pagesInUse": pages,
         "pages": telemetry["pages"],
@@ -108,15 +128,19 @@ def counter_gates(page: Page, report: ParityReport) -> None:
     page.evaluate("() => window.__lab.despawnAll([0])")
 
 
-def moved_gates(page: Page, report: ParityReport, telemetry: dict[str, Any]) -> None:
+def moved_gates(page: Page, report: ParityReport, telemetry: dict[str, Any], moving: bool = True) -> None:
     """Only what moved: after a tick that moved every body (``telemetry``), a still frame, one spawn beside
     still bodies, and a tick with all bodies but one paused, the pre-pass ran exactly the bodies whose rows
     changed. Each frame deforms as few bodies as the gate needs (a beetle's body takes over a second on
-    SwiftShader)."""
+    SwiftShader). ``moving`` (moves_every_tick): whether a tick moves body 0, which was deformed before the
+    spawned bodies came; a still creature's tick deforms only the bodies never deformed yet."""
     moved = telemetry["stats"]["lastFrameDeformedBodies"]
+    expected = telemetry["count"] - (0 if moving else 1)
     report.gate(
-        "bodies deformed by a tick that moves every live body (pre-pass: all of them)",
-        abs(moved - telemetry["count"]),
+        "bodies deformed by a tick that moves every live body (pre-pass: all of them)"
+        if moving
+        else "bodies deformed by a tick of a still creature (pre-pass: the spawned bodies, never deformed)",
+        abs(moved - expected),
         0,
         "bodies",
     )
@@ -142,17 +166,20 @@ def moved_gates(page: Page, report: ParityReport, telemetry: dict[str, Any]) -> 
     before = page.evaluate(f"() => window.__lab.stagedPose({held[0]})")
     page.evaluate("() => window.__lab.stepTicks(1)")
     deformed = page.evaluate("() => window.__lab.telemetry()")["stats"]["lastFrameDeformedBodies"]
+    one = 1 if moving else 0
     report.gate(
-        "bodies deformed by a tick with every body but one paused, beyond that one",
-        abs(deformed - 1),
+        "bodies deformed by a tick with every body but one paused, beyond that one"
+        if moving
+        else "bodies deformed by a tick of a still creature with every body but one paused",
+        abs(deformed - one),
         0,
         "bodies",
-        passed=deformed == 1 and page.evaluate(f"() => window.__lab.stagedPose({held[0]})") == before,
+        passed=deformed == one and page.evaluate(f"() => window.__lab.stagedPose({held[0]})") == before,
     )
     page.evaluate(f"() => window.__lab.resume({held})")
 
 
-def cull_gates(page: Page, report: ParityReport, scale: float) -> None:
+def cull_gates(page: Page, report: ParityReport, scale: float, moving: bool = True) -> None:
     """Culling by posed bounds (population.cullWith): bodies spread far beyond body 0's portrait view,
     culled to that view for a tick: only the bodies it sees are drawn and deformed; when culling stops, the
     bodies that moved while culled are deformed before they are drawn: what every body's pre-pass stored
@@ -175,9 +202,11 @@ def cull_gates(page: Page, report: ParityReport, scale: float) -> None:
         passed=culled["lastFrameDrawnBodies"] + culled["lastFrameCulledBodies"] == live
         and 0 < culled["lastFrameCulledBodies"] < live,
     )
+    # Every drawn body is new but body 0, which a still creature's tick leaves as it was deformed.
+    drawn_new = culled["lastFrameDrawnBodies"] - (0 if moving else 1)
     report.gate(
         "bodies deformed by a culled tick beyond the bodies drawn (only what is seen)",
-        abs(culled["lastFrameDeformedBodies"] - culled["lastFrameDrawnBodies"]),
+        abs(culled["lastFrameDeformedBodies"] - drawn_new),
         0,
         "bodies",
     )
