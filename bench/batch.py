@@ -118,9 +118,9 @@ def main() -> None:
         cluster, address = _cluster_address(2)
         try:
             env = {**base, "CREATUREGEN_CACHE": str(work / "cache-dask")}
-            runs["dask2"] = _run(
-                [str(specs), "-o", str(work / "out-dask"), *tiers, "--scheduler", address], env
-            )
+            # The workers were started by this process: they get the empty cache through --cache.
+            dask = [str(specs), "-o", str(work / "out-dask"), *tiers, "--scheduler", address]
+            runs["dask2"] = _run([*dask, "--cache", env["CREATUREGEN_CACHE"]], env)
         finally:
             cluster.close()
     env = {**base, "CREATUREGEN_CACHE": str(work / "cache-2")}

@@ -70,6 +70,15 @@ def test_specs_get_unique_ids_and_folders_are_searched(tmp_path: Path) -> None:
         spec_files([str(tmp_path / "empty")])
 
 
+def test_a_path_that_is_not_there_is_one_line_exit_2_and_nothing_written(tmp_path: Path) -> None:
+    done = _build_many(str(tmp_path / "missing"), "-o", str(tmp_path / "out"))
+    assert done.returncode == 2
+    assert done.stderr.strip().splitlines() == [
+        f"creaturegen build-many: {tmp_path / 'missing'}: no such file or folder"
+    ]
+    assert not (tmp_path / "out").exists()
+
+
 def test_packages_travel_as_bytes_and_stay_inside_their_folder(tmp_path: Path) -> None:
     source = tmp_path / "a"
     (source / "core").mkdir(parents=True)

@@ -223,52 +223,78 @@ def test_frost_demo_wipes_the_pane_under_a_mouse_stroke(base_url: str, lab_out: 
     views = ["final", "historyNextR"]
     points = STROKE_POINTS + AWAY_POINTS
     url = f"{base_url}demo-frost.html?pkg={slug}&pointer={wiring}"
-    with launch_lab_page(url, viewport=VIEWPORT) as lab_page:
-        assert_clean(lab_page)
-        page = lab_page.page
-        expected = "effect.attachPointer" if wiring == "auto" and has_attach else "page fallback"
-        assert lab_page.lab["pointerSource"].startswith(expected)
-        assert canvas_size(lab_page) == list(VIEWPORT)
-        history = page.evaluate("(p) => window.__lab.history(p)", points)
-        assert history["values"] == [0] * len(points), "the pane starts frozen"
-        assert history["mean"] == 0, "the pane starts frozen"
-        # A readback can stall the loop past the effect's maxInterval (a clock jump drops queued input):
-        # let the loop run normally again before the stroke.
-        wait_frames(lab_page, 2)
+    # A frame that the loaded machine stalls past the effect's maxInterval is a clock jump, and the time
+    # policy drops the input queued then (as specified; counted in counters.discontinuities): that stroke
+    # did not test the pointer path, so it is wiped again on a fresh page, twice at most.
+    for _ in range(3):
+        with launch_lab_page(url, viewport=VIEWPORT) as lab_page:
+            if _stroke_wipes_the_pane(lab_page, expected_source(wiring, has_attach), points, views):
+                _follows_the_window(lab_page)
+                return
+    pytest.fail("every one of 3 strokes met a frame stalled past maxInterval: the pointer path went untested")
 
-        width, height = VIEWPORT
-        page.mouse.move(0.4 * width, STROKE_V * height)
-        page.mouse.down()
-        for sweep in range(3):  # wipe back and forth, the way one wipes a window
-            for i in range(11):
-                u = 0.4 + 0.02 * (i if sweep % 2 == 0 else 10 - i)
-                page.mouse.move(u * width, STROKE_V * height)
-                page.wait_for_timeout(25)
-        page.mouse.up()
-        wait_frames(lab_page, 1)
 
-        history = page.evaluate("(p) => window.__lab.history(p)", points)
-        composite = page.evaluate("(a) => window.__lab.capture(a[0], { views: a[1] })", [points, views])
-        counters = page.evaluate("() => window.__lab.counters()")
-        detail = f"history {history}\ncomposite {composite}\ncounters {counters}\n{lab_page.transcript()}"
-        stroke, away = history["values"][: len(STROKE_POINTS)], history["values"][len(STROKE_POINTS) :]
-        assert counters["segmentsQueued"] >= 20, detail
-        assert counters["segmentsRejected"] == 0, detail
-        # The thaw relaxes back within about a second (decay 1.05 /s), so these are lower bounds, not levels.
-        assert min(stroke) > 0.05, detail
-        assert max(stroke) > 0.2, detail
-        assert max(away) == 0, detail
-        assert history["mean"] > 0, detail
-        # The composite pass sees the same history: its history view is lit under the stroke only.
-        shown = [rgb[0] for rgb in composite["historyNextR"]]
-        assert min(shown[: len(STROKE_POINTS)]) > 20, detail
-        assert max(shown[len(STROKE_POINTS) :]) < 1, detail
-        assert len(composite["final"]) == len(points)
+def expected_source(wiring: str, has_attach: bool) -> str:
+    return "effect.attachPointer" if wiring == "auto" and has_attach else "page fallback"
 
-        # The canvas and the effect follow the window.
-        page.set_viewport_size({"width": 400, "height": 260})
-        wait_frames(lab_page, 2)
-        assert canvas_size(lab_page) == [400, 260]
-        assert page.evaluate("() => window.__lab.counters().resizes") >= 1
-        assert page.evaluate("() => window.__lab.capture([]).then(c => [c.width, c.height])") == [400, 260]
-        assert_clean(lab_page)
+
+def _stroke_wipes_the_pane(
+    lab_page: LabPage, expected: str, points: list[list[float]], views: list[str]
+) -> bool:
+    """One stroke on a frozen pane, its history and composite checked; False (nothing asserted after the
+    stroke) when a frame stalled past maxInterval during it."""
+    assert_clean(lab_page)
+    page = lab_page.page
+    assert lab_page.lab["pointerSource"].startswith(expected)
+    assert canvas_size(lab_page) == list(VIEWPORT)
+    history = page.evaluate("(p) => window.__lab.history(p)", points)
+    assert history["values"] == [0] * len(points), "the pane starts frozen"
+    assert history["mean"] == 0, "the pane starts frozen"
+    # A readback can stall the loop past the effect's maxInterval (a clock jump drops queued input):
+    # let the loop run normally again before the stroke.
+    wait_frames(lab_page, 2)
+    jumps = page.evaluate("() => window.__lab.counters().discontinuities")
+
+    width, height = VIEWPORT
+    page.mouse.move(0.4 * width, STROKE_V * height)
+    page.mouse.down()
+    for sweep in range(3):  # wipe back and forth, the way one wipes a window
+        for i in range(11):
+            u = 0.4 + 0.02 * (i if sweep % 2 == 0 else 10 - i)
+            page.mouse.move(u * width, STROKE_V * height)
+            page.wait_for_timeout(25)
+    page.mouse.up()
+    wait_frames(lab_page, 1)
+
+    history = page.evaluate("(p) => window.__lab.history(p)", points)
+    composite = page.evaluate("(a) => window.__lab.capture(a[0], { views: a[1] })", [points, views])
+    counters = page.evaluate("() => window.__lab.counters()")
+    if counters["discontinuities"] > jumps:
+        print(f"a frame stalled past maxInterval during the stroke: {counters}")
+        return False
+    detail = f"history {history}\ncomposite {composite}\ncounters {counters}\n{lab_page.transcript()}"
+    stroke, away = history["values"][: len(STROKE_POINTS)], history["values"][len(STROKE_POINTS) :]
+    assert counters["segmentsQueued"] >= 20, detail
+    assert counters["segmentsRejected"] == 0, detail
+    # The thaw relaxes back within about a second (decay 1.05 /s), so these are lower bounds, not levels.
+    assert min(stroke) > 0.05, detail
+    assert max(stroke) > 0.2, detail
+    assert max(away) == 0, detail
+    assert history["mean"] > 0, detail
+    # The composite pass sees the same history: its history view is lit under the stroke only.
+    shown = [rgb[0] for rgb in composite["historyNextR"]]
+    assert min(shown[: len(STROKE_POINTS)]) > 20, detail
+    assert max(shown[len(STROKE_POINTS) :]) < 1, detail
+    assert len(composite["final"]) == len(points)
+    return True
+
+
+def _follows_the_window(lab_page: LabPage) -> None:
+    """The canvas and the effect follow the window."""
+    page = lab_page.page
+    page.set_viewport_size({"width": 400, "height": 260})
+    wait_frames(lab_page, 2)
+    assert canvas_size(lab_page) == [400, 260]
+    assert page.evaluate("() => window.__lab.counters().resizes") >= 1
+    assert page.evaluate("() => window.__lab.capture([]).then(c => [c.width, c.height])") == [400, 260]
+    assert_clean(lab_page)

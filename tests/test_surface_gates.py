@@ -559,8 +559,12 @@ def test_point_contact_decided_exactly() -> None:
         (Fraction(p) + Fraction(q)) / 2 for p, q in zip(t1[0], t1[2], strict=True)
     ]
     normal = np.cross(t1[1] - t1[0], t1[2] - t1[0])
-    naive = np.dot(normal, m - t1[0])
-    assert naive != 0.0  # float says "off the plane"; exactly it is on it
+    # Float says "off the plane" in some evaluation orders; exactly it is on it. Which order a float dot
+    # takes depends on the BLAS kernel of the CPU (np.dot said off-plane on the machine this test was
+    # written on, on the plane on an AMD EPYC), so the orders are written out in Python floats here.
+    v = m - t1[0]
+    orders = [sum(float(normal[i]) * float(v[i]) for i in order) for order in ((0, 1, 2), (2, 1, 0))]
+    assert any(naive != 0.0 for naive in orders), orders
     up = normal / np.linalg.norm(normal)
     side = np.array([1.0, 0.0, 0.0]) - up * up[0]
 

@@ -287,11 +287,11 @@ def _run_stats(jobs: list[_Job], batch: _Batch, wall: float) -> dict[str, Any]:
 
 def build_many(paths: Sequence[str], out: Path, options: BatchOptions) -> dict[str, Any]:
     """Build every spec under ``paths`` into ``out`` and write ``out/index.json`` and ``out/index.html``."""
-    out.mkdir(parents=True, exist_ok=True)
     specs = load_batch(spec_files(paths, exclude=out))
     jobs = _jobs(specs, options)
     todo = _plan(out, jobs, options)
-    engine = make_engine(options)
+    engine = make_engine(options)  # before anything is written: a bad path or scheduler writes nothing
+    out.mkdir(parents=True, exist_ok=True)
     batch = _Batch(out, options, engine)
 
     def say(text: str) -> None:
