@@ -25,7 +25,13 @@ from creaturegen.frost.brush import Segment
 from creaturegen.frost.params import params_from_plan
 from creaturegen.frost.schedule import bin_steps
 from creaturegen.frost.structure import generate_structure
-from creaturegen.frost.timeline import chunk_steps, late_steps, split_interval
+from creaturegen.frost.timeline import (
+    advance_instants,
+    chunk_steps,
+    classify_interval,
+    late_steps,
+    split_interval,
+)
 from creaturegen.lab.browser import launch_lab_page
 from creaturegen.lab.frost_history import strokes_at_once
 from creaturegen.lab.frost_texels import shipped_structure
@@ -384,6 +390,48 @@ def test_readme_page_script_runs_as_written(packages: dict[str, Path], tmp_path:
         errors = [line for line in lab.console if line.startswith(("[error]", "[warning]"))]
         assert errors == [], lab.transcript()
         assert lab.page_errors == [], lab.transcript()
+
+
+def test_js_time_policy_is_the_numpy_time_policy(packages: dict[str, Path]) -> None:
+    """classifyInterval and a stall's advance ends (advanceInstants) in the JS core against numpy's, exactly:
+    every decision, and cut instants equal to the last bit (both JSON forms round-trip doubles)."""
+    intervals = [
+        (0.0, 0.0),
+        (1.0, 0.5),
+        (0.0, 1.0),
+        (0.0, 1.0 + 2**-40),
+        (0.1, 2.6),
+        (1 / 3, 4.0),
+        (0.0, 4.0 + 1e-9),
+        (12.345, 14.2),
+        (0.0, float("nan")),
+        (0.0, float("inf")),
+    ]
+    limits = [(1.0, 4.0), (1.0, 1.0), (0.3, 1.7)]
+    core = packages["budgeted"] / "core" / "frost-core.js"
+    script = f"""
+const {{ advanceInstants, classifyInterval }} = await import({json.dumps(core.as_uri())});
+const intervals = {json.dumps([[p, c] for p, c in intervals])};  // NaN and Infinity: JS literals too
+const out = [];
+for (const [maxInterval, catchUp] of {json.dumps(limits)}) {{
+  for (const [p, c] of intervals) {{
+    const decision = classifyInterval(p, c, maxInterval, catchUp);
+    out.push([decision, decision === 'catch-up' ? advanceInstants(p, c, maxInterval) : []]);
+  }}
+}}
+console.log(JSON.stringify(out));
+"""
+    done = run_node(script, packages["budgeted"])
+    assert done.returncode == 0, done.stderr
+    got = json.loads(done.stdout)
+    expected = []
+    for max_interval, catch_up in limits:
+        for previous, current in intervals:
+            decision = classify_interval(previous, current, max_interval, catch_up)
+            ends = advance_instants(previous, current, max_interval) if decision == "catch-up" else []
+            expected.append([decision, ends])
+    assert got == expected
+    assert sum(d == "catch-up" for d, _ in got) >= 6
 
 
 def test_js_late_steps_are_the_numpy_late_steps(packages: dict[str, Path]) -> None:

@@ -167,6 +167,12 @@ def test_parity_job_catches_a_debug_view_switch_that_does_nothing(
             "idle",
             "reversed interval runs the reset policy",
         ),
+        (
+            "a runtime that drops a stalled frame's input where the spec catches it up",
+            ('"catchUp": 4.0', '"catchUp": 1.0'),
+            "idle",
+            "a frame stalled 2.5 s runs catch-up",
+        ),
     ],
 )
 def test_parity_job_catches_a_wrong_runtime_policy(

@@ -26,6 +26,7 @@ from creaturegen.frost.reference import STATE_CHANNELS, FrostReference, remap_bi
 from creaturegen.frost.schedule import TileScheduler, bin_steps, diffusion_substeps, texel_box
 from creaturegen.frost.timeline import (
     Step,
+    advance_instants,
     chunk_steps,
     classify_interval,
     late_steps,
@@ -210,13 +211,63 @@ def test_coverage_radius_centre_and_average_pressure() -> None:
         (0.0, math.nan, "discontinuity"),
         (0.0, math.inf, "discontinuity"),
         (-math.inf, 0.0, "discontinuity"),
-        (0.0, 1.5, "discontinuity"),
+        (0.0, 1.5, "catch-up"),
+        (0.0, 4.0, "catch-up"),
+        (0.0, 4.5, "discontinuity"),
         (0.0, 1.0, "advance"),
         (2.0, 2.0 + 1 / 60, "advance"),
     ],
 )
 def test_classify_interval(previous: float, current: float, expected: str) -> None:
-    assert classify_interval(previous, current, 1.0) == expected
+    assert classify_interval(previous, current, 1.0, 4.0) == expected
+    off = "discontinuity" if expected == "catch-up" else expected  # catchUp <= maxInterval: catch-up is off
+    assert classify_interval(previous, current, 1.0, 1.0) == off
+
+
+@pytest.mark.parametrize(("previous", "current"), [(0.1, 2.6), (1 / 3, 1 / 3 + 1.0000001), (7.25, 11.0)])
+def test_advance_instants_cut_a_stall_into_equal_advances(previous: float, current: float) -> None:
+    ends = advance_instants(previous, current, 1.0)
+    assert len(ends) == math.ceil(current - previous)
+    assert ends[-1] == current
+    pieces = np.diff([previous, *ends])
+    assert np.all(pieces > 0)
+    assert np.all(pieces <= 1.0 + 1e-15)
+    np.testing.assert_allclose(pieces, (current - previous) / len(ends), rtol=1e-12)
+
+
+def test_a_stalled_frame_deposits_the_whole_stroke_as_ordinary_frames_would() -> None:
+    """A frame stalled 2.5 s during the stroke, its segments arriving late (as attachPointer queues them):
+    caught up as 3 advances, it is bit for bit the run whose frames were at the advances' ends, and the
+    whole stroke deposits. Switched off (catchUp = maxInterval) the same stall drops the queued input."""
+
+    def run(params: FrostParams, instants: list[float]) -> FrostReference:
+        reference = FrostReference(params, *GRID)
+        pending = path.conformance_segments()
+        for previous, current in itertools.pairwise(instants):
+            arrived = [g for g in pending if g.t1 <= current]
+            pending = pending[len(arrived) :]
+            for segment in arrived:
+                reference.queue(segment)
+            reference.update(previous, current)
+        return reference
+
+    params = params_of("frost-full")
+    assert (params.max_interval, params.catch_up) == (1.0, 4.0)  # the defaults
+    head = [k / 60 for k in range(7)]
+    stalled = run(params, [*head, 0.1 + 2.5, 2.7])
+    frame = stalled.counters.history[6]
+    assert (frame.decision, frame.advances) == ("catch-up", 3)
+    assert stalled.counters.catch_ups == 1
+    assert stalled.counters.discontinuities == 0
+    assert stalled.counters.frames == 8
+    assert stalled.counters.pointer_seconds == pytest.approx(path.STROKE_SECONDS, abs=1e-12)
+    frames = run(params, [*head, *advance_instants(0.1, 2.6, 1.0), 2.7])
+    np.testing.assert_array_equal(stalled.state, frames.state)
+    assert stalled.counters.pointer_seconds == frames.counters.pointer_seconds
+
+    off = run(dataclasses.replace(params, catch_up=params.max_interval), [*head, 0.1 + 2.5, 2.7])
+    assert off.counters.history[6].decision == "discontinuity"
+    assert off.counters.pointer_seconds < 0.1 * path.STROKE_SECONDS
 
 
 def test_split_interval_cuts_at_segment_boundaries() -> None:

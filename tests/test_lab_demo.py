@@ -223,15 +223,9 @@ def test_frost_demo_wipes_the_pane_under_a_mouse_stroke(base_url: str, lab_out: 
     views = ["final", "historyNextR"]
     points = STROKE_POINTS + AWAY_POINTS
     url = f"{base_url}demo-frost.html?pkg={slug}&pointer={wiring}"
-    # A frame that the loaded machine stalls past the effect's maxInterval is a clock jump, and the time
-    # policy drops the input queued then (as specified; counted in counters.discontinuities): that stroke
-    # did not test the pointer path, so it is wiped again on a fresh page, twice at most.
-    for _ in range(3):
-        with launch_lab_page(url, viewport=VIEWPORT) as lab_page:
-            if _stroke_wipes_the_pane(lab_page, expected_source(wiring, has_attach), points, views):
-                _follows_the_window(lab_page)
-                return
-    pytest.fail("every one of 3 strokes met a frame stalled past maxInterval: the pointer path went untested")
+    with launch_lab_page(url, viewport=VIEWPORT) as lab_page:
+        _stroke_wipes_the_pane(lab_page, expected_source(wiring, has_attach), points, views)
+        _follows_the_window(lab_page)
 
 
 def expected_source(wiring: str, has_attach: bool) -> str:
@@ -240,9 +234,10 @@ def expected_source(wiring: str, has_attach: bool) -> str:
 
 def _stroke_wipes_the_pane(
     lab_page: LabPage, expected: str, points: list[list[float]], views: list[str]
-) -> bool:
-    """One stroke on a frozen pane, its history and composite checked; False (nothing asserted after the
-    stroke) when a frame stalled past maxInterval during it."""
+) -> None:
+    """One stroke on a frozen pane, its history and composite checked. A frame the loaded machine stalls
+    past maxInterval during the stroke is caught up (counters.catchUps), so the stroke deposits anyway; only
+    a stall past catchUp (a clock jump) would drop it."""
     assert_clean(lab_page)
     page = lab_page.page
     assert lab_page.lab["pointerSource"].startswith(expected)
@@ -250,9 +245,6 @@ def _stroke_wipes_the_pane(
     history = page.evaluate("(p) => window.__lab.history(p)", points)
     assert history["values"] == [0] * len(points), "the pane starts frozen"
     assert history["mean"] == 0, "the pane starts frozen"
-    # A readback can stall the loop past the effect's maxInterval (a clock jump drops queued input):
-    # let the loop run normally again before the stroke.
-    wait_frames(lab_page, 2)
     jumps = page.evaluate("() => window.__lab.counters().discontinuities")
 
     width, height = VIEWPORT
@@ -269,10 +261,9 @@ def _stroke_wipes_the_pane(
     history = page.evaluate("(p) => window.__lab.history(p)", points)
     composite = page.evaluate("(a) => window.__lab.capture(a[0], { views: a[1] })", [points, views])
     counters = page.evaluate("() => window.__lab.counters()")
-    if counters["discontinuities"] > jumps:
-        print(f"a frame stalled past maxInterval during the stroke: {counters}")
-        return False
     detail = f"history {history}\ncomposite {composite}\ncounters {counters}\n{lab_page.transcript()}"
+    print(f"stalled frames caught up during the test: {counters['catchUps']}")
+    assert counters["discontinuities"] == jumps, f"a frame stalled past catchUp during the stroke\n{detail}"
     stroke, away = history["values"][: len(STROKE_POINTS)], history["values"][len(STROKE_POINTS) :]
     assert counters["segmentsQueued"] >= 20, detail
     assert counters["segmentsRejected"] == 0, detail
@@ -286,7 +277,6 @@ def _stroke_wipes_the_pane(
     assert min(shown[: len(STROKE_POINTS)]) > 20, detail
     assert max(shown[len(STROKE_POINTS) :]) < 1, detail
     assert len(composite["final"]) == len(points)
-    return True
 
 
 def _follows_the_window(lab_page: LabPage) -> None:

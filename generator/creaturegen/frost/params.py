@@ -67,6 +67,9 @@ class FrostParams:
     idle_when_converged: bool
     tolerance: float
     max_interval: float
+    catch_up: (
+        float  # longest interval caught up in advances of at most max_interval (timeline.advance_instants)
+    )
     discontinuity: Literal["reset", "freeze"]
     resize_policy: Literal["clear", "preserve-remap"]
     max_steps: int = MAX_STEPS_PER_DISPATCH
@@ -99,6 +102,7 @@ class FrostParams:
             "idleWhenConverged": self.idle_when_converged,
             "tolerance": self.tolerance,
             "maxInterval": self.max_interval,
+            "catchUp": self.catch_up,
             "discontinuity": self.discontinuity,
             "resizePolicy": self.resize_policy,
             "maxSteps": self.max_steps,
@@ -125,6 +129,7 @@ def params_from_plan(plan: dict[str, Any]) -> FrostParams:
         idle_when_converged=plan["idleWhenConverged"],
         tolerance=plan["tolerance"],
         max_interval=plan["maxInterval"],
+        catch_up=plan["catchUp"],
         discontinuity=plan["discontinuity"],
         resize_policy=plan["resizePolicy"],
         max_steps=plan["maxSteps"],
@@ -147,6 +152,7 @@ def frost_params(spec: FrostEffectSpec) -> FrostParams:
         idle_when_converged=spec.update.idleWhenConverged,
         tolerance=spec.update.convergenceTolerance,
         max_interval=spec.time.maxIntervalSeconds,
+        catch_up=spec.time.catchUpSeconds,
         discontinuity=spec.time.discontinuity,
         resize_policy=spec.resizePolicy,
     )

@@ -24,6 +24,7 @@ from .schedule import BoolGrid, TilePlan, TileScheduler, bin_steps, diffusion_su
 from .timeline import (
     Decision,
     Step,
+    advance_instants,
     chunk_steps,
     classify_interval,
     late_steps,
@@ -52,6 +53,7 @@ class FrameReport:
     retired_tiles: int = 0
     substeps: int = 0
     late_steps: int = 0
+    advances: int = 0  # 1 for an ordinary frame, ceil(dt / maxInterval) for a caught-up stall
     pointer_seconds: float = 0.0
     bin_entries: int = 0  # (step, segment) entries over the chunks' bins (schedule.bin_steps)
     texel_steps: int = 0  # law evaluations: Σ over updated texels of their bin's entries
@@ -62,6 +64,7 @@ class FrameReport:
 class Counters:
     frames: int = 0
     discontinuities: int = 0
+    catch_ups: int = 0
     dispatches: int = 0
     texels: int = 0
     pointer_seconds: float = 0.0
@@ -105,7 +108,7 @@ class FrostReference:
         self._last_end[segment.stream] = segment.t1
 
     def update(self, previous: float, current: float) -> FrameReport:
-        decision = classify_interval(previous, current, self.params.max_interval)
+        decision = classify_interval(previous, current, self.params.max_interval, self.params.catch_up)
         report = FrameReport(decision=decision)
         if decision == "none":
             return report
@@ -120,32 +123,55 @@ class FrostReference:
                 self._allocate(self.width, self.height)
             self.counters.history.append(report)
             return report
-        if self.origin is None:
-            self.origin = previous
-        late = late_steps(previous, self.pending[self.fresh_from :], self.origin)
-        steps = late + split_interval(previous, current, self.pending)
-        report.late_steps = len(late)
-        report.pointer_seconds = sum(s.pointer_seconds for s in steps)
-        substeps = diffusion_substeps(self.params.diffusivity, current - previous, self.height)
-        plan = self.scheduler.plan(steps, current - previous, substeps)
-        self._apply(plan, steps, substeps, report, current - previous)
-        self.pending = [g for g in self.pending if g.t1 > current]
-        self.fresh_from = len(self.pending)
+        origin = self.origin = previous if self.origin is None else self.origin
+        ends = [current]
+        if decision == "catch-up":
+            self.counters.catch_ups += 1
+            ends = advance_instants(previous, current, self.params.max_interval)
+        start, fresh = previous, True
+        for end in ends:
+            fresh = not self._advance(start, end, origin, report, fresh) and fresh
+            start = end
         self.counters.pointer_seconds += report.pointer_seconds
         self.counters.dispatches += report.dispatches
         self.counters.texels += report.texels
         self.counters.history.append(report)
         return report
 
+    def _advance(
+        self, previous: float, current: float, origin: float, report: FrameReport, fresh: bool
+    ) -> bool:
+        """One advance over [previous, current): a frame's whole interval, or one piece of a catch-up (the
+        segments queued during a stall are fresh for the first piece only). ``fresh``: no advance of this
+        frame has updated tiles yet. Returns whether this one did."""
+        late = late_steps(previous, self.pending[self.fresh_from :], origin)
+        steps = late + split_interval(previous, current, self.pending)
+        report.late_steps += len(late)
+        report.pointer_seconds += sum(s.pointer_seconds for s in steps)
+        substeps = diffusion_substeps(self.params.diffusivity, current - previous, self.height)
+        plan = self.scheduler.plan(steps, current - previous, substeps)
+        self._apply(plan, steps, substeps, report, current - previous, first=fresh)
+        report.advances += 1
+        self.pending = [g for g in self.pending if g.t1 > current]
+        self.fresh_from = len(self.pending)
+        return bool(plan.update)
+
     def _apply(
-        self, plan: TilePlan, steps: list[Step], substeps: int, report: FrameReport, frame_dt: float
+        self,
+        plan: TilePlan,
+        steps: list[Step],
+        substeps: int,
+        report: FrameReport,
+        frame_dt: float,
+        first: bool,
     ) -> None:
+        """Retire, update and diffuse over one advance; the report sums over a frame's advances. ``first``:
+        no earlier advance of the frame updated tiles: this one's first chunk restarts the last-frame deposit
+        channels."""
         w, h = self.width, self.height
-        report.steps, report.update_tiles, report.retired_tiles = (
-            len(steps),
-            len(plan.update),
-            len(plan.retire),
-        )
+        report.steps += len(steps)
+        report.update_tiles += len(plan.update)
+        report.retired_tiles += len(plan.retire)
         if plan.retire:
             self.state[plan.mask(plan.retire, w, h)] = 0.0
             report.dispatches += 1
@@ -155,14 +181,14 @@ class FrostReference:
         mask = plan.mask(plan.update, w, h)
         texels = plan.texels(plan.update)
         for chunk_index, chunk in enumerate(chunk_steps(steps, self.params.max_steps, self.params.max_pairs)):
-            self._law(chunk, mask, first=chunk_index == 0)
+            self._law(chunk, mask, first=first and chunk_index == 0)
             bins = bin_steps(chunk, self.params, w, h)
             report.bin_entries += bins.total
             report.texel_steps += bins.texel_steps(mask)
             report.unbinned_texel_steps += int(np.count_nonzero(mask)) * sum(len(s.segments) for s in chunk)
             report.dispatches += 1
             report.texels += texels
-        report.substeps = substeps
+        report.substeps += substeps
         if substeps:
             rate = self.params.diffusivity * (frame_dt / substeps) * h * h
             for _ in range(substeps):

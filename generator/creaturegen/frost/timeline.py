@@ -1,9 +1,11 @@
 """From two render instants to the piecewise-constant input intervals the law integrates.
 
 dt always comes from a pair of instants, never from one timestamp or a frame counter. Equal instants mean no
-elapsed interval (nothing runs). A reversed, non-finite or over-long interval is a discontinuity: the
-declared policy runs (reset clears the history, freeze keeps it and skips the interval), and the effect
-counts it; nothing is clamped silently.
+elapsed interval (nothing runs). A forward interval longer than max_interval but at most catch_up is a
+stalled frame: it is caught up as equal advances (``advance_instants``), so the pointer input queued during
+the stall deposits in full. A reversed, non-finite or longer interval is a discontinuity: the declared
+policy runs (reset clears the history, freeze keeps it and skips the interval), and the effect counts it;
+nothing is clamped silently.
 """
 
 from __future__ import annotations
@@ -15,17 +17,28 @@ from typing import Literal
 
 from .brush import Segment
 
-Decision = Literal["advance", "none", "discontinuity"]
+Decision = Literal["advance", "none", "catch-up", "discontinuity"]
 
 
-def classify_interval(previous: float, current: float, max_interval: float) -> Decision:
+def classify_interval(previous: float, current: float, max_interval: float, catch_up: float) -> Decision:
     if not (math.isfinite(previous) and math.isfinite(current)):
         return "discontinuity"
     if current == previous:
         return "none"
-    if current < previous or current - previous > max_interval:
+    if current < previous:
         return "discontinuity"
-    return "advance"
+    elapsed = current - previous
+    if elapsed <= max_interval:
+        return "advance"
+    return "catch-up" if elapsed <= catch_up else "discontinuity"
+
+
+def advance_instants(previous: float, current: float, max_interval: float) -> list[float]:
+    """Where the advances of a caught-up interval end: ceil(elapsed / max_interval) equal pieces, the last
+    ending exactly at ``current``. Written as the JS core writes it (same operations, same order), so both
+    cut at bit-identical instants."""
+    count = math.ceil((current - previous) / max_interval)
+    return [previous + (current - previous) * i / count for i in range(1, count)] + [current]
 
 
 @dataclass(frozen=True)

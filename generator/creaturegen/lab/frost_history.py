@@ -6,6 +6,9 @@ every texel and channel), fed the way the package is fed.
 - late arrival: the stroke's segments queued only once their end sample arrived (as attachPointer delivers
   them): GPU vs numpy fed the same way, numpy late vs in advance ≤ 1e-12 (the catch-up is exact for the
   law), and the pointer time deposited equals the stroke's duration;
+- a stalled frame (run with the time-policy gates): the late-arriving stroke with one frame stalled past
+  maxInterval during it: the declared catch-up (or discontinuity) runs as numpy's does, the history
+  matches, and a caught-up stroke deposits in full;
 - several strokes at once: the GPU's binned update vs numpy's unbinned one, and the bins' work per frame;
 - frame-rate invariance: GPU 30 vs GPU 120 within the numpy float64 30-vs-120 difference plus the same
   tolerance; numpy float64 30 vs 120 ≤ 1e-12 for the law (diffusion off; with diffusion on its
@@ -16,6 +19,7 @@ from __future__ import annotations
 
 import dataclasses
 import itertools
+from typing import Any
 
 import numpy as np
 import numpy.typing as npt
@@ -24,7 +28,8 @@ from ..frost.brush import Segment
 from ..frost.formats import HALF_FLOAT_TOLERANCE, replay
 from ..frost.params import FrostParams
 from ..frost.path import FRAME_RATES, STROKE_SECONDS, STROKE_START, conformance_segments, frame_instants
-from ..frost.reference import STORAGE_OF_FORMAT, FrostReference, Storage
+from ..frost.reference import STORAGE_OF_FORMAT, FrameReport, FrostReference, Storage
+from ..spec.messages import number
 from .frost_session import FrostLab
 from .report import ParityReport
 
@@ -198,6 +203,30 @@ def _during_stroke_gate(
     report.measurements["duringStrokeChannelMax"] = channels.tolist()
 
 
+def _deliver_late(
+    lab: FrostLab, references: list[FrostReference], instants: list[float]
+) -> tuple[list[dict[str, Any]], list[FrameReport]]:
+    """Feed the conformance stroke as a real pointer delivers it, to the GPU and to each reference: each
+    segment queued only when its end sample has arrived (before the first update reaching t1). Returns the
+    GPU's frame reports and the first reference's."""
+    pending = conformance_segments()
+    gpu: list[dict[str, Any]] = []
+    cpu: list[FrameReport] = []
+    for previous, current in itertools.pairwise(instants):
+        arrived = [g for g in pending if g.t1 <= current]
+        pending = pending[len(arrived) :]
+        if arrived:
+            lab.queue(arrived)
+        for target in references:
+            for segment in arrived:
+                target.queue(segment)
+        cpu.append(references[0].update(previous, current))
+        for target in references[1:]:
+            target.update(previous, current)
+        gpu.append(lab.update(previous, current))
+    return gpu, cpu
+
+
 def _late_arrival_gate(
     lab: FrostLab,
     params: FrostParams,
@@ -206,30 +235,21 @@ def _late_arrival_gate(
     storage: Storage,
     tolerance: float,
 ) -> None:
-    """The conformance stroke delivered as a real pointer delivers it: each segment queued only when its end
-    sample has arrived (before the first update reaching t1), so most overlap an instant already rendered.
-    GPU vs numpy fed the same way; numpy float64 fed late vs fed in advance (the catch-up is exact for the
-    law); and the pointer time deposited on the GPU, over the stroke's duration."""
+    """The conformance stroke delivered as a real pointer delivers it (``_deliver_late``), so most segments
+    overlap an instant already rendered. GPU vs numpy fed the same way; numpy float64 fed late vs fed in
+    advance (the catch-up is exact for the law); and the pointer time deposited on the GPU, over the
+    stroke's duration."""
     lab.reset()
     reference = FrostReference(params, size[0], size[1], storage)
     exact = FrostReference(dataclasses.replace(params, diffusivity=0.0), size[0], size[1], "float64")
     advance_known = FrostReference(dataclasses.replace(params, diffusivity=0.0), size[0], size[1], "float64")
-    pending = conformance_segments()
-    for segment in pending:
+    for segment in conformance_segments():
         advance_known.queue(segment)
     before = lab.counters()["effect"]["pointerSeconds"]
     instants = frame_instants(60)
+    _deliver_late(lab, [reference, exact], instants)
     for previous, current in itertools.pairwise(instants):
-        arrived = [g for g in pending if g.t1 <= current]
-        pending = pending[len(arrived) :]
-        if arrived:
-            lab.queue(arrived)
-        for target in (reference, exact):
-            for segment in arrived:
-                target.queue(segment)
-            target.update(previous, current)
         advance_known.update(previous, current)
-        lab.update(previous, current)
     gpu = lab.history()
     report.gate(
         "GPU vs numpy history, segments arriving late (60 FPS)",
@@ -253,4 +273,61 @@ def _late_arrival_gate(
     report.measurements["lateArrival"] = {
         "pointerTimeRatio": ratio,
         "lateSteps": sum(r.late_steps for r in reference.counters.history),
+    }
+
+
+def stall_seconds(params: FrostParams) -> float:
+    """How long the stalled-frame gate stalls a frame: 2.5 advances where catch-up is on (at most catchUp),
+    otherwise twice maxInterval (a discontinuity)."""
+    if params.catch_up > params.max_interval:
+        return min(params.catch_up, 2.5 * params.max_interval)
+    return 2.0 * params.max_interval
+
+
+def stalled_frame_gate(lab: FrostLab, params: FrostParams, report: ParityReport) -> None:
+    """The late-arriving stroke at 60 FPS with one frame stalled during it (a hitch under load): the GPU's
+    decision and advances equal numpy's, its history matches numpy's, and with catch-up on the whole stroke
+    still deposits (pointer time / stroke duration = 1). Part of the time-policy gates ("idle" group)."""
+    info = lab.info()
+    size = (int(info["historySize"][0]), int(info["historySize"][1]))
+    storage = STORAGE_OF_FORMAT[info["format"]]
+    tolerance = FORMAT_TOLERANCE[info["format"]]
+    lab.reset()
+    reference = FrostReference(params, size[0], size[1], storage)
+    instants = frame_instants(60)
+    stalled = next(i for i, t in enumerate(instants) if t >= STROKE_START + 0.05)
+    resumed = instants[stalled] + stall_seconds(params)
+    timeline = instants[: stalled + 1] + [resumed + k / 60 for k in range(6)]
+    before = lab.counters()["effect"]["pointerSeconds"]
+    gpu_reports, cpu_reports = _deliver_late(lab, [reference], timeline)
+    gpu_frame, cpu_frame = gpu_reports[stalled], cpu_reports[stalled]
+    expected = "catch-up" if params.catch_up > params.max_interval else "discontinuity"
+    stall = number(resumed - instants[stalled])
+    report.gate(
+        f"a frame stalled {stall} s runs {expected} (GPU decision, advances as numpy)",
+        abs(int(gpu_frame["advances"]) - cpu_frame.advances),
+        0,
+        "advances",
+        passed=gpu_frame["decision"] == cpu_frame.decision == expected
+        and gpu_frame["advances"] == cpu_frame.advances,
+    )
+    report.gate(
+        "GPU vs numpy history after a stalled frame",
+        float(np.abs(lab.history() - reference.state).max()),
+        tolerance,
+        "history units",
+    )
+    ratio = (lab.counters()["effect"]["pointerSeconds"] - before) / STROKE_SECONDS
+    if expected == "catch-up":
+        report.gate(
+            "pointer time deposited / stroke duration, a frame stalled during it",
+            abs(ratio - 1.0),
+            1e-9,
+            "|ratio - 1|",
+        )
+    report.measurements["stalledFrame"] = {
+        "seconds": resumed - instants[stalled],
+        "decision": gpu_frame["decision"],
+        "advances": gpu_frame["advances"],
+        "pointerTimeRatio": ratio,
     }

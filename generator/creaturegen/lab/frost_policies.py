@@ -1,7 +1,8 @@
 """Frost parity gates on the declared policies: once converged, frames dispatch nothing (counted by the
-package, per frame); equal instants do nothing and a reversed interval runs the declared discontinuity
-policy; a resize follows the declared policy (clear → zeros; preserve-remap → the numpy bilinear remap of
-the GPU history read back just before).
+package, per frame); equal instants do nothing, a reversed interval runs the declared discontinuity
+policy and a stalled frame the declared catch-up (frost_history.stalled_frame_gate); a resize follows the
+declared policy (clear → zeros; preserve-remap → the numpy bilinear remap of the GPU history read back
+just before).
 """
 
 from __future__ import annotations
@@ -12,6 +13,7 @@ from ..frost.formats import HALF_FLOAT_TOLERANCE
 from ..frost.params import FrostParams
 from ..frost.path import conformance_segments, frame_instants
 from ..frost.reference import remap_bilinear
+from .frost_history import stalled_frame_gate
 from .frost_session import FrostLab
 from .report import ParityReport
 
@@ -53,6 +55,7 @@ def idle_and_time_gates(lab: FrostLab, params: FrostParams, report: ParityReport
         "history units",
         passed=reversed_report["decision"] == "discontinuity" and after == expected_after and before > 0,
     )
+    stalled_frame_gate(lab, params, report)
 
 
 def resize_gate(lab: FrostLab, params: FrostParams, report: ParityReport, canvas: tuple[int, int]) -> None:

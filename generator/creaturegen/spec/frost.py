@@ -199,13 +199,41 @@ class Structure(StrictModel):
         return value
 
 
+#: Most equal advances one catch-up frame may run: each costs about one ordinary frame's dispatches.
+MAX_CATCH_UP_ADVANCES = 16
+
+
 class TimePolicy(StrictModel):
-    """What a negative, NaN or too-long interval does: never a silent clamp."""
+    """What a negative, NaN or too-long interval does: never a silent clamp.
+
+    A frame the browser stalls for a second or two (a hitch under load) is not a seek: the pointer kept
+    moving and its timestamped segments are queued. Up to ``catchUpSeconds`` the interval is caught up as
+    equal advances of at most ``maxIntervalSeconds``, so that input deposits in full; past it (a tab in
+    the background for minutes, a seek) the declared discontinuity policy runs.
+    """
 
     discontinuity: Literal["reset", "freeze"] = "reset"
     maxIntervalSeconds: Positive = Field(
-        default=1.0, description="Longer intervals are discontinuities and run the declared policy."
+        default=1.0,
+        description="Longest interval one advance integrates; longer ones are caught up or jumps.",
     )
+    catchUpSeconds: NonNegative = Field(
+        default=4.0,
+        description="Longest interval caught up (in advances of at most maxIntervalSeconds) before it is a "
+        "discontinuity; at most maxIntervalSeconds turns catch-up off.",
+    )
+
+    @field_validator("catchUpSeconds")
+    @classmethod
+    def _catch_up_bounded(cls, value: float, info: ValidationInfo) -> float:
+        longest = info.data.get("maxIntervalSeconds")
+        if longest is not None and value > MAX_CATCH_UP_ADVANCES * longest:
+            bound = number(MAX_CATCH_UP_ADVANCES * longest)
+            raise rule_error(
+                f"must be <= {MAX_CATCH_UP_ADVANCES} x maxIntervalSeconds ({bound}):"
+                " each advance of a catch-up costs a frame's work; raise maxIntervalSeconds or lower this"
+            )
+        return value
 
 
 class FrostEffectSpec(StrictModel):

@@ -177,7 +177,7 @@ async function main() {
       `pointer    ${pointerSource}`,
       `tier       ${effect.tier}, history ${hw}×${hh} ${effect.format}`,
       `canvas     ${size.x}×${size.y} px (dpr ${renderer.getPixelRatio()}), ${fps.toFixed(0)} fps`,
-      `segments   ${c.segmentsQueued} queued, ${c.segmentsRejected} rejected; ${c.discontinuities} clock jumps`,
+      `segments   ${c.segmentsQueued} queued, ${c.segmentsRejected} rejected; ${c.catchUps ?? 0} stalls caught up, ${c.discontinuities} clock jumps`,
     ].join('\n');
     problem.textContent = [...errors, ...warnings].slice(-3).join('\n');
   }
@@ -185,7 +185,7 @@ async function main() {
   function frame(ms) {
     now = clock(ms);
     if (previous !== null) {
-      effect.update(previous, now); // dt from two instants; a jump over 1 s runs the declared policy
+      effect.update(previous, now); // dt from two instants; a stall is caught up, a longer jump runs the policy
       fps = 0.9 * fps + 0.1 / Math.max(now - previous, 1e-3);
     }
     previous = now;

@@ -2,12 +2,29 @@
 // Line for line the same algorithm as generator/creaturegen/frost/{timeline,schedule}.py; the numbers
 // (rates, radii, tolerance, policy) come from plan.js, which the compiler wrote from the same FrostParams.
 
-/** 'advance' | 'none' (equal instants) | 'discontinuity' (reversed, non-finite or too long). */
-export function classifyInterval(previous, current, maxInterval) {
+/**
+ * 'advance' | 'none' (equal instants) | 'catch-up' (a stalled frame: longer than maxInterval, at most
+ * catchUp) | 'discontinuity' (reversed, non-finite or longer than that).
+ */
+export function classifyInterval(previous, current, maxInterval, catchUp) {
   if (!Number.isFinite(previous) || !Number.isFinite(current)) return 'discontinuity';
   if (current === previous) return 'none';
-  if (current < previous || current - previous > maxInterval) return 'discontinuity';
-  return 'advance';
+  if (current < previous) return 'discontinuity';
+  const elapsed = current - previous;
+  if (elapsed <= maxInterval) return 'advance';
+  return elapsed <= catchUp ? 'catch-up' : 'discontinuity';
+}
+
+/**
+ * Where the advances of a caught-up interval end: ceil(elapsed / maxInterval) equal pieces, the last ending
+ * exactly at `current` (the same operations in the same order as the Python reference: bit-identical cuts).
+ */
+export function advanceInstants(previous, current, maxInterval) {
+  const count = Math.ceil((current - previous) / maxInterval);
+  const ends = [];
+  for (let i = 1; i < count; i++) ends.push(previous + ((current - previous) * i) / count);
+  ends.push(current);
+  return ends;
 }
 
 /**

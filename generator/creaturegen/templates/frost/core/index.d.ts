@@ -28,7 +28,7 @@ export interface NormalizedSegment {
   stream: number;
 }
 
-export type IntervalDecision = 'advance' | 'none' | 'discontinuity';
+export type IntervalDecision = 'advance' | 'none' | 'catch-up' | 'discontinuity';
 
 /**
  * One piecewise-constant input interval of a frame: the segments active throughout it (one per stream at
@@ -65,7 +65,10 @@ export interface FrostParams {
   tileSize: number;
   idleWhenConverged: boolean;
   tolerance: number;
+  /** Longest interval one advance integrates (seconds). */
   maxInterval: number;
+  /** Longest interval caught up in advances of at most maxInterval before it is a discontinuity (seconds). */
+  catchUp: number;
   maxSteps: number;
   /** (step, segment) pairs per update dispatch; a chunk ends before it would hold more. */
   maxPairs: number;
@@ -131,8 +134,15 @@ export interface FrostPlan {
 
 export const PLAN: FrostPlan;
 
-/** 'advance' | 'none' (equal instants) | 'discontinuity' (reversed, non-finite or too long). */
-export function classifyInterval(previous: number, current: number, maxInterval: number): IntervalDecision;
+/**
+ * 'advance' | 'none' (equal instants) | 'catch-up' (longer than maxInterval, at most catchUp: a stalled frame)
+ * | 'discontinuity' (reversed, non-finite or longer).
+ */
+export function classifyInterval(
+  previous: number, current: number, maxInterval: number, catchUp: number,
+): IntervalDecision;
+/** Where the advances of a caught-up interval end: ceil(elapsed / maxInterval) equal pieces, the last at `current`. */
+export function advanceInstants(previous: number, current: number, maxInterval: number): number[];
 /** Why a segment is refused, or null (`lastEnd`: where its stream's previous segment ended). */
 export function validateSegment(segment: NormalizedSegment, lastEnd: number | null): string | null;
 /** Why a segment is refused for overlapping `maxStreams` or more other streams' queued segments, or null. */

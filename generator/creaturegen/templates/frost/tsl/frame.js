@@ -1,21 +1,21 @@
-// One frame of the history (effect.update): classify the interval since the last render instant, turn the
-// queued segments into piecewise-constant steps (late segments' missed spans first), let the tile
-// scheduler pick the tiles that can still change, then run the update kernel over them chunk by chunk,
-// the diffusion substeps, and the clear of tiles that have converged. Returns the frame's report, also
-// kept as counters.lastFrame.
+// One frame of the history (effect.update): classify the interval since the last render instant (a stalled
+// frame is caught up as several advances), turn the queued segments into piecewise-constant steps (late
+// segments' missed spans first), let the tile scheduler pick the tiles that can still change, then run the
+// update kernel over them chunk by chunk, the diffusion substeps, and the clear of tiles that have
+// converged. Returns the frame's report, also kept as counters.lastFrame.
 import {
-  chunkSteps, classifyInterval, diffusionSubsteps, lateSteps, splitInterval,
+  advanceInstants, chunkSteps, classifyInterval, diffusionSubsteps, lateSteps, splitInterval,
 } from '../core/frost-core.js';
 import { dispatch2d, run, runLinear, uploadTiles } from './dispatch.js';
 import { bindComposite, reset } from './history.js';
 import { writeChunk } from './intake.js';
 
 export function update(state, previousInstant, currentInstant) {
-  const { params, counters, pending } = state;
-  const decision = classifyInterval(previousInstant, currentInstant, params.maxInterval);
+  const { params, counters } = state;
+  const decision = classifyInterval(previousInstant, currentInstant, params.maxInterval, params.catchUp);
   const report = {
-    decision, steps: 0, dispatches: 0, texels: 0, updateTiles: 0, retiredTiles: 0, substeps: 0, lateSteps: 0,
-    pointerSeconds: 0, binEntries: 0, texelSteps: 0,
+    decision, steps: 0, dispatches: 0, texels: 0, updateTiles: 0, retiredTiles: 0, substeps: 0, advances: 0,
+    lateSteps: 0, pointerSeconds: 0, binEntries: 0, texelSteps: 0,
   };
   if (decision === 'none') return report;
   counters.frames += 1;
@@ -26,10 +26,38 @@ export function update(state, previousInstant, currentInstant) {
     counters.lastFrame = report;
     return report;
   }
-  const frameDt = currentInstant - previousInstant;
   if (state.origin === null) state.origin = previousInstant;
+  // A stalled frame (longer than maxInterval, at most catchUp) runs as equal advances of at most
+  // maxInterval: the pointer input queued during the stall deposits in full.
+  let ends = [currentInstant];
+  if (decision === 'catch-up') {
+    counters.catchUps += 1;
+    ends = advanceInstants(previousInstant, currentInstant, params.maxInterval);
+  }
+  let start = previousInstant;
+  let fresh = true;
+  for (let i = 0; i < ends.length; i++) {
+    fresh = !advance(state, start, ends[i], report, fresh) && fresh;
+    start = ends[i];
+  }
+  if (report.updateTiles === 0 && report.retiredTiles === 0) counters.idleFrames += 1;
+  counters.lateSteps += report.lateSteps;
+  counters.pointerSeconds += report.pointerSeconds;
+  bindComposite(state);
+  report.dispatches = counters.dispatches - before;
+  counters.texelsDispatched += report.texels;
+  counters.lastFrame = report;
+  return report;
+}
+
+// One advance over [previousInstant, currentInstant): a frame's whole interval or one piece of a catch-up.
+// `fresh`: no advance of this frame has updated tiles yet (its first chunk restarts the deposit channels).
+// Adds to the frame's report; returns whether it updated tiles.
+function advance(state, previousInstant, currentInstant, report, fresh) {
+  const { params, pending } = state;
+  const frameDt = currentInstant - previousInstant;
   // Segments known only after the instant they overlap (a pointer segment arrives with its end sample)
-  // first deposit their missed part exactly, then the frame's own interval runs.
+  // first deposit their missed part exactly, then the interval itself runs.
   const late = lateSteps(previousInstant, pending, state.origin, state.freshFrom);
   const split = splitInterval(previousInstant, currentInstant, pending);
   const steps = late.length > 0 ? late.concat(split) : split;
@@ -38,34 +66,29 @@ export function update(state, previousInstant, currentInstant) {
   const substeps = diffusionSubsteps(params.diffusivity, frameDt, state.histH, params.diffusionStability);
   const { updateCount, retireCount } = state.scheduler.plan(steps, frameDt, substeps);
   const tileArea = state.scheduler.tileWidth * state.scheduler.tileHeight;
-  Object.assign(report, {
-    steps: steps.length, updateTiles: updateCount, retiredTiles: retireCount, lateSteps: late.length, pointerSeconds,
-  });
-  counters.lateSteps += late.length;
-  counters.pointerSeconds += pointerSeconds;
+  report.steps += steps.length;
+  report.updateTiles += updateCount;
+  report.retiredTiles += retireCount;
+  report.lateSteps += late.length;
+  report.pointerSeconds += pointerSeconds;
+  report.advances += 1;
   if (retireCount > 0) {
     uploadTiles(state, state.scheduler.retire, retireCount);
     runLinear(state, state.kernels.clear, retireCount);
     report.texels += retireCount * tileArea;
   }
   if (updateCount > 0) {
-    runUpdate(state, steps, updateCount, tileArea, report);
-    report.substeps = substeps;
+    runUpdate(state, steps, updateCount, tileArea, report, fresh);
+    report.substeps += substeps;
     if (substeps > 0) runDiffusion(state, frameDt, substeps, updateCount, tileArea, report);
-  } else if (retireCount === 0) {
-    counters.idleFrames += 1;
   }
   for (let i = pending.length - 1; i >= 0; i--) if (pending[i].t1 <= currentInstant) pending.splice(i, 1);
   state.freshFrom = pending.length;
-  bindComposite(state);
-  report.dispatches = counters.dispatches - before;
-  counters.texelsDispatched += report.texels;
-  counters.lastFrame = report;
-  return report;
+  return updateCount > 0;
 }
 
-// Time jumped (a reversed interval or one past maxInterval): drop the queued input, and reset the history
-// when the plan's discontinuity policy says so.
+// Time jumped (a reversed or non-finite interval, or one past catchUp): drop the queued input, and reset the
+// history when the plan's discontinuity policy says so.
 function jump(state, currentInstant) {
   state.counters.discontinuities += 1;
   state.pending.length = 0;
@@ -77,7 +100,7 @@ function jump(state, currentInstant) {
 
 // The update kernel over the frame's steps, one dispatch per chunk (chunkSteps: at most maxSteps steps
 // and maxPairs pairs each); every dispatch swaps the ping-pong.
-function runUpdate(state, steps, updateCount, tileArea, report) {
+function runUpdate(state, steps, updateCount, tileArea, report, fresh) {
   const { params, scheduler, bins, kernels } = state;
   const full = params.policy === 'full-field';
   if (!full) uploadTiles(state, scheduler.update, updateCount);
@@ -88,7 +111,7 @@ function runUpdate(state, steps, updateCount, tileArea, report) {
     report.texelSteps += bins.single
       ? bins.total * (full ? state.histW * state.histH : liveTexels(state, updateCount))
       : bins.texelSteps(updated);
-    state.uFirstChunk.value = index === 0 ? 1 : 0;
+    state.uFirstChunk.value = fresh && index === 0 ? 1 : 0;
     if (full) run(state, kernels.update2d[state.current], dispatch2d(state));
     else runLinear(state, kernels.updateTiles[state.current], updateCount);
     state.current = 1 - state.current;

@@ -77,8 +77,8 @@ export function createState(renderer, tierName, tier, binning) {
     write: [storageTexture(textures[0]), storageTexture(textures[1])],
     // ---- bookkeeping ----------------------------------------------------------------------------------
     counters: {
-      frames: 0, idleFrames: 0, discontinuities: 0, dispatches: 0, texelsDispatched: 0, lastFrame: null,
-      segmentsQueued: 0, segmentsRejected: 0, resizes: 0, lateSteps: 0, pointerSeconds: 0,
+      frames: 0, idleFrames: 0, discontinuities: 0, catchUps: 0, dispatches: 0, texelsDispatched: 0,
+      lastFrame: null, segmentsQueued: 0, segmentsRejected: 0, resizes: 0, lateSteps: 0, pointerSeconds: 0,
     },
     // ---- the pieces built on this state, set once by createFrostEffect ---------------------------------
     kernels: null, // kernels.js
