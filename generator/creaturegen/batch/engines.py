@@ -83,14 +83,6 @@ class DaskEngine:
         info = self._client.scheduler_info()
         return sum(int(w.get("nthreads", 1)) for w in info.get("workers", {}).values())
 
-    def chromium_workers(self) -> int:
-        info = self._client.scheduler_info()
-        return sum(
-            1
-            for w in info.get("workers", {}).values()
-            if w.get("resources", {}).get(CHROMIUM_RESOURCE, 0) >= 1
-        )
-
     def submit(
         self, fn: Callable[[T], TaskResult], task: T, *, key: str, chromium: bool = False
     ) -> TaskFuture:

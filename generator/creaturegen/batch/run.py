@@ -142,7 +142,9 @@ class _Batch:
         self._submit("build", job, task)
 
     def parity(self, job: _Job) -> None:
-        folder = self.out / job.record["package"] if job.record else self.out
+        """Runs only for a job whose package landed, in this run or an earlier one (its record says where)."""
+        assert job.record is not None
+        folder = self.out / job.record["package"]
         task = ParityTask(
             key=job.key,
             spec_id=job.spec.id,

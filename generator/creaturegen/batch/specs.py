@@ -5,7 +5,6 @@ worker on another machine has no copy of the user's folder).
 
 from __future__ import annotations
 
-import hashlib
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -36,10 +35,6 @@ class BatchSpec:
     name: str
     errors: tuple[str, ...] = ()
     info: dict[str, object] = field(default_factory=dict, compare=False, hash=False)
-
-    @property
-    def sha256(self) -> str:
-        return hashlib.sha256(self.data).hexdigest()
 
 
 def spec_files(named: Sequence[str], exclude: Path | None = None) -> list[Path]:
