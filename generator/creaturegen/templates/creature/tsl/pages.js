@@ -17,7 +17,7 @@ export function createPages(state) {
   const pages = [];
   for (let first = 0; first < capacity; first += pageSize) {
     const size = Math.min(pageSize, capacity - first);
-    const pose = instancedArray(new Float32Array(size * floatsPerInstance), 'vec4');
+    const pose = instancedArray(new Float32Array(size * floatsPerInstance), 'vec4').setName('cgPose'); // deformStorage
     const mesh = new THREE.Mesh(geometry, null);
     mesh.count = 0;
     mesh.castShadow = true;
@@ -26,8 +26,8 @@ export function createPages(state) {
     mesh.name = `${data.slug}.page${pages.length}`;
     group.add(mesh);
     const deform = deformStorage(size, vertices);
-    const list = instanceList(size);
-    const drawList = instanceList(size);
+    const list = instanceList(size, 'cgList');
+    const drawList = instanceList(size, 'cgDrawList');
     pages.push({
       first, size, pose, mesh, staging: pose.value.array, deform, deformView: deformView(deform), kernels: new Map(), shell: null,
       // The bodies the next pre-pass runs (list, its CPU copy `listed`), and which bodies' rows changed

@@ -117,7 +117,7 @@ export const CREATURE = Object.freeze({
   "registers": 13,
   "roundCone": [0, 0, 0, 0, 0, 0, 0],
   "signatures": {
-    "compilerSignature": "1520d013543fa87a5f42eb2683a7d9c82feb290f8b8870ff03fa654bf622ae67",
+    "compilerSignature": "114d180b62f4bbbc51d2b15e51903eb14222b77575c1f4da4bc1ac9c7c18189f",
     "geometryDigest": "400b0d18a2a9f6bbbfe5b441f89767f552a4f3b4c45a368d1129d632e1d2f4f1",
     "topologySignature": "330d551e8c006f84b01459c84db69ca8c43aec5bc9d9083d3e85c291be5a68bf"
   },
