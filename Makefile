@@ -39,7 +39,7 @@ FUZZ_BUILDS ?= 50
 # Only folders that exist: git does not keep empty ones, and ruff fails on a missing path.
 LINT_PATHS := $(wildcard generator tests bench)
 
-.PHONY: help setup system-deps build bestiary parity corpus fuzz test schemas lab bench golden clean distclean
+.PHONY: help setup system-deps build bestiary parity corpus fuzz test test-full schemas lab bench golden clean distclean
 
 help:
 	@echo "make setup    .venv + pip install -e '.[dev]', npm ci in $(WEB_LAB), chromium + lavapipe"
@@ -48,7 +48,8 @@ help:
 	@echo "make parity   build every frost and creature example and run its parity job (out/<slug>/parity/)"
 	@echo "make corpus   build $(CORPUS_COUNT) generated creatures at $(CORPUS_TIERS): out/corpus/report.json, index.html"
 	@echo "make fuzz     $(FUZZ_CASES) hostile/mutated specs through the gate + $(FUZZ_BUILDS) real builds: out/fuzz/report.json"
-	@echo "make test     ruff, ruff format --check, mypy, pytest (browser tests included)"
+	@echo "make test     ruff, ruff format --check, mypy, pytest (browser tests included; per-example jobs on a subset)"
+	@echo "make test-full  pytest with the per-example parity and motion-core checks on every example"
 	@echo "make schemas  export JSON Schemas into schemas/"
 	@echo "make golden   rebuild tests/golden/ (the byte-for-byte package records); review and commit the diff"
 	@echo "make lab      serve $(WEB_LAB)/ at http://$(LAB_HOST):$(LAB_PORT)/"
@@ -152,6 +153,11 @@ test: setup
 	$(VENV)/bin/mypy generator
 	@echo "==> pytest"
 	CREATUREGEN_STRICT_SETUP=1 $(VENV_PY) -m pytest -n $(PYTEST_WORKERS) $(PYTEST_ARGS)
+
+# make test with the per-example browser parity jobs and motion-core checks on every example (tests/conftest.py
+# TEST_FULL), not only the fixed subset.
+test-full: setup
+	CREATUREGEN_TEST_FULL=1 CREATUREGEN_STRICT_SETUP=1 $(VENV_PY) -m pytest -n $(PYTEST_WORKERS) $(PYTEST_ARGS)
 
 # --- housekeeping -----------------------------------------------------------------------------
 

@@ -43,6 +43,22 @@ CREATURE_EXAMPLES = [
     "lizard.json",
     "moth.json",
 ]
+#: ``make test-full`` (CREATUREGEN_TEST_FULL=1) runs the per-example browser parity jobs on every example;
+#: ``make test`` on a fixed subset that covers every locomotion family the runtime has (hop, walk with a rope
+#: tail, swim, flight), so that it stays near its time budget on two cores. ``make parity`` and ``make
+#: bestiary`` run the parity job of every example too.
+TEST_FULL = os.environ.get("CREATUREGEN_TEST_FULL") == "1"
+PARITY_SUBSET = [
+    "reference/hopper.json",
+    "reference/quadruped.json",
+    "reference/swimmer.json",
+    "reference/flyer.json",
+]
+PARITY_EXAMPLES = CREATURE_EXAMPLES if TEST_FULL else PARITY_SUBSET
+#: Frost examples whose full parity job runs in ``make test`` ("default" is the bare spec, the defaults'
+#: acceptance); every one in ``make test-full``.
+FROST_PARITY_EXAMPLES = None if TEST_FULL else ("default", "frost-budgeted")
+
 #: Creature specs under tests/fixtures/ that the motion tests (gates, envelope, JS core parity, allocation)
 #: run beside the examples, named ``fixtures/<file>``; the browser parity jobs do not build them. The spider
 #: is an octopod; the kangaroo a hopper on its two hind legs.

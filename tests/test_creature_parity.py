@@ -17,7 +17,7 @@ from pathlib import Path
 
 import pytest
 
-from conftest import CREATURE_EXAMPLES, build_example
+from conftest import PARITY_EXAMPLES, build_example
 from creaturegen.lab.creature_parity import GATE_GROUPS, run_creature_parity
 from creaturegen.lab.creature_population import PAGE_SIZE, SPAWNS
 
@@ -38,7 +38,7 @@ GRID_EXAMPLES = ("reference/hopper.json",)
 
 
 @pytest.mark.browser
-@pytest.mark.parametrize("name", CREATURE_EXAMPLES)
+@pytest.mark.parametrize("name", PARITY_EXAMPLES)
 def test_every_example_passes_every_parity_gate(name: str, out_root: Path) -> None:
     package = build(name, out_root)
     groups = GATE_GROUPS if name in GRID_EXAMPLES else tuple(g for g in GATE_GROUPS if g != "grid")

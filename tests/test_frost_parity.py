@@ -10,7 +10,7 @@ from pathlib import Path
 
 import pytest
 
-from conftest import EXAMPLES, run_cli
+from conftest import EXAMPLES, FROST_PARITY_EXAMPLES, run_cli
 from creaturegen.lab.frost_parity import run_frost_parity
 from creaturegen.spec import slugify
 
@@ -39,7 +39,10 @@ def built(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Path]:
 
 
 @pytest.mark.browser
-@pytest.mark.parametrize("example", [p.stem for p in FROST_EXAMPLES] + ["default"])
+@pytest.mark.parametrize(
+    "example",
+    [e for e in [p.stem for p in FROST_EXAMPLES] + ["default"] if e in (FROST_PARITY_EXAMPLES or [e])],
+)
 def test_frost_package_passes_every_parity_gate(built: dict[str, Path], example: str) -> None:
     package = built[example]
     report = run_frost_parity(package)
@@ -119,7 +122,7 @@ def test_parity_job_catches_a_wrong_catch_up_of_late_segments(built: dict[str, P
     exact = "return exp(rb.negate().mul(tau)).mul(x).add("
     assert exact in text
     effect.write_text(text.replace(exact, "return x.add("))
-    result = run_frost_parity(broken, groups=("history",))
+    result = run_frost_parity(broken, groups=("history", "late"))
     status = {g["name"]: g["status"] for g in result.gates}
     assert status["GPU vs numpy history, segments arriving late (60 FPS)"] == "fail", result.summary()
     assert status["GPU vs numpy history at 60 FPS"] == "pass", result.summary()
@@ -260,6 +263,6 @@ def test_parity_job_catches_a_wrong_binned_update(
     text = target.read_text()
     assert swap[0] in text, planted_defect
     target.write_text(text.replace(swap[0], swap[1]))  # every occurrence: StepBins counts, then fills
-    result = run_frost_parity(broken, groups=("history",))
+    result = run_frost_parity(broken, groups=("strokes",))
     failed = [g["name"] for g in result.gates if g["status"] == "fail"]
     assert any(name.startswith(gate) for name in failed), f"{planted_defect}: {result.summary()}"

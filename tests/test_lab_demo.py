@@ -2,9 +2,10 @@
 demo pages, which use a package through its public API only (web_lab/demo-creature.*, web_lab/demo-frost.*).
 
 The browser tests open them headless (WebGPU on SwiftShader) in a small window, so that a frame takes a
-fraction of a second: the frost effect treats an interval over its maxInterval (1 s) as a clock jump and
-resets. A screenshot of a WebGPU canvas is blank headless, so the frost wipe is checked through readbacks:
-the effect's history (``readHistory()``) and the composite's own view of it, rendered off-screen.
+fraction of a second (a frame stalled past the frost effect's maxInterval, 1 s, is caught up in advances of
+at most that, up to catchUpSeconds). A screenshot of a WebGPU canvas is blank headless, so the frost wipe
+is checked through readbacks: the effect's history (``readHistory()``) and the composite's own view of it,
+rendered off-screen.
 """
 
 from __future__ import annotations

@@ -18,7 +18,9 @@ import pytest
 from conftest import (
     CREATURE_EXAMPLES,
     MOTION_FIXTURES,
+    PARITY_EXAMPLES,
     REPO,
+    TEST_FULL,
     build_example,
     node,
     run_node_tests,
@@ -51,6 +53,11 @@ TICKS = 1000
 #: The examples and the motion fixtures (the eight-legged spider, the kangaroo: a hopper on two legs): every
 #: gate and the JS core parity run on each.
 MOTION_SPECS = [*CREATURE_EXAMPLES, *MOTION_FIXTURES]
+#: The specs whose built package's core is checked in Node (JS vs Python, allocation): every one in
+#: ``make test-full``; in ``make test`` the browser-parity subset (every locomotion family), the beetle
+#: (built anyway for the compiler-thread probe) and the spider (an octopod).
+PACKAGE_MOTION_SUBSET = [*PARITY_EXAMPLES, "beetle.json", "fixtures/spider.json"]
+PACKAGE_MOTION_SPECS = MOTION_SPECS if TEST_FULL else PACKAGE_MOTION_SUBSET
 
 
 def motion_data(name: str) -> MotionData:
@@ -353,7 +360,7 @@ def test_the_gates_can_fail() -> None:
     assert g.plant_drift > 1e-3
 
 
-@pytest.mark.parametrize("name", MOTION_SPECS)
+@pytest.mark.parametrize("name", PACKAGE_MOTION_SPECS)
 def test_js_core_matches_python(name: str, creature_out: Path, tmp_path: Path) -> None:
     package = build_example(name, creature_out)
     data = motion_data(name)
@@ -432,7 +439,7 @@ def windows(alloc: dict[str, Any]) -> str:
     return ", ".join(f"{w['heapGrowthBytes']} B / {w['collections']} GCs" for w in alloc["windows"])
 
 
-@pytest.mark.parametrize("name", MOTION_SPECS)
+@pytest.mark.parametrize("name", PACKAGE_MOTION_SPECS)
 def test_steady_state_steps_do_not_allocate(name: str, creature_out: Path) -> None:
     """V8 heap growth and garbage collections over 5000 steps of one creature after a 20000-step warm-up
     and a full collection (the cleanest of five windows: the steady state, not a late compilation)."""
@@ -462,8 +469,9 @@ def test_the_probe_does_not_depend_on_when_the_compiler_thread_runs(creature_out
 
 
 def test_the_probe_catches_a_step_that_allocates(creature_out: Path, tmp_path: Path) -> None:
-    """The hexapod's own core with one small array kept per step (dropped every 64): the probe must see it."""
-    package = build_example("reference/hexapod.json", creature_out)
+    """The quadruped's own core with one small array kept per step (dropped every 64): the probe must see
+    it."""
+    package = build_example("reference/quadruped.json", creature_out)
     planted = wrapped_core(
         package,
         tmp_path / "planted.mjs",
@@ -480,5 +488,5 @@ def test_the_probe_catches_a_step_that_allocates(creature_out: Path, tmp_path: P
         "}\n",
     )
     alloc = allocation_probe(planted)["allocation"]
-    print(f"planted hexapod: {alloc['heapGrowthBytes']} B, {alloc['collections']} GCs ({windows(alloc)})")
+    print(f"planted quadruped: {alloc['heapGrowthBytes']} B, {alloc['collections']} GCs ({windows(alloc)})")
     assert alloc["collections"] > 0 or alloc["heapGrowthBytes"] >= ALLOC_SLACK_BYTES, windows(alloc)

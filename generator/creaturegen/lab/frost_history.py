@@ -86,8 +86,23 @@ def history_gates(lab: FrostLab, params: FrostParams, report: ParityReport) -> N
     )
     report.measurements["historySize"] = list(size)
     report.measurements["format"] = info["format"]
-    _late_arrival_gate(lab, params, report, size, storage, tolerance)
-    _strokes_at_once_gate(lab, params, report, size, storage, tolerance)
+
+
+def _history_context(lab: FrostLab) -> tuple[tuple[int, int], Storage, float]:
+    """The GPU history's size, the numpy storage that rounds like its format, and that format's tolerance."""
+    info = lab.info()
+    size = (int(info["historySize"][0]), int(info["historySize"][1]))
+    return size, STORAGE_OF_FORMAT[info["format"]], FORMAT_TOLERANCE[info["format"]]
+
+
+def late_arrival_gates(lab: FrostLab, params: FrostParams, report: ParityReport) -> None:
+    """The "late" group: segments queued as a real pointer delivers them (``_late_arrival_gate``)."""
+    _late_arrival_gate(lab, params, report, *_history_context(lab))
+
+
+def strokes_at_once_gates(lab: FrostLab, params: FrostParams, report: ParityReport) -> None:
+    """The "strokes" group: several strokes at once through the binned update (``_strokes_at_once_gate``)."""
+    _strokes_at_once_gate(lab, params, report, *_history_context(lab))
 
 
 def strokes_at_once(count: int, seconds: float = 0.5, pieces: int = 8) -> list[Segment]:
@@ -288,10 +303,7 @@ def stalled_frame_gate(lab: FrostLab, params: FrostParams, report: ParityReport)
     """The late-arriving stroke at 60 FPS with one frame stalled during it (a hitch under load): the GPU's
     decision and advances equal numpy's, its history matches numpy's, and with catch-up on the whole stroke
     still deposits (pointer time / stroke duration = 1). Part of the time-policy gates ("idle" group)."""
-    info = lab.info()
-    size = (int(info["historySize"][0]), int(info["historySize"][1]))
-    storage = STORAGE_OF_FORMAT[info["format"]]
-    tolerance = FORMAT_TOLERANCE[info["format"]]
+    size, storage, tolerance = _history_context(lab)
     lab.reset()
     reference = FrostReference(params, size[0], size[1], storage)
     instants = frame_instants(60)

@@ -44,7 +44,7 @@ from pathlib import Path
 
 from ..frost.params import params_from_plan
 from .browser import launch_lab_page
-from .frost_history import history_gates
+from .frost_history import history_gates, late_arrival_gates, strokes_at_once_gates
 from .frost_policies import idle_and_time_gates, resize_gate
 from .frost_session import FrostLab
 from .frost_texels import mirror_gate, structure_gate
@@ -66,7 +66,9 @@ def open_lab(package: Path, canvas: tuple[int, int]) -> Iterator[FrostLab]:
         yield FrostLab(lab_page.page, lab_page.console, lab_page.page_errors)
 
 
-GATE_GROUPS = ("history", "idle", "resize", "structure", "mirror", "views", "trail")
+#: "history": the conformance stroke at 30/60/120 FPS and during it; "late": segments arriving late;
+#: "strokes": several strokes at once (frost_history). A planted-defect test runs only the group it targets.
+GATE_GROUPS = ("history", "late", "strokes", "idle", "resize", "structure", "mirror", "views", "trail")
 
 
 def run_frost_parity(
@@ -83,6 +85,10 @@ def run_frost_parity(
         adapter_gate(report, report.measurements["adapter"])
         if "history" in groups:
             history_gates(lab, params, report)
+        if "late" in groups:
+            late_arrival_gates(lab, params, report)
+        if "strokes" in groups:
+            strokes_at_once_gates(lab, params, report)
         if "idle" in groups:
             idle_and_time_gates(lab, params, report)
         if "resize" in groups:
