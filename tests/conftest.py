@@ -57,7 +57,7 @@ PARITY_SUBSET = [
 PARITY_EXAMPLES = CREATURE_EXAMPLES if TEST_FULL else PARITY_SUBSET
 #: Frost examples whose full parity job runs in ``make test`` ("default" is the bare spec, the defaults'
 #: acceptance); every one in ``make test-full``.
-FROST_PARITY_EXAMPLES = None if TEST_FULL else ("default", "frost-budgeted")
+FROST_PARITY_SUBSET = ("default", "frost-budgeted")
 
 #: Creature specs under tests/fixtures/ that the motion tests (gates, envelope, JS core parity, allocation)
 #: run beside the examples, named ``fixtures/<file>``; the browser parity jobs do not build them. The spider

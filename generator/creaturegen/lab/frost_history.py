@@ -55,11 +55,9 @@ def reference_replay(params: FrostParams, size: tuple[int, int], fps: int, stora
 
 def history_gates(lab: FrostLab, params: FrostParams, report: ParityReport) -> None:
     info = lab.info()
-    size = (int(info["historySize"][0]), int(info["historySize"][1]))
-    storage = STORAGE_OF_FORMAT[info["format"]]
+    size, storage, tolerance = _history_context(lab)
     gpu: dict[int, Array] = {}
     exact: dict[int, Array] = {}
-    tolerance = FORMAT_TOLERANCE[info["format"]]
     for fps in FRAME_RATES:
         gpu[fps] = lab.replay(conformance_segments(), frame_instants(fps))
         expected = reference_replay(params, size, fps, storage)

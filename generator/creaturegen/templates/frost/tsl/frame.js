@@ -27,18 +27,19 @@ export function update(state, previousInstant, currentInstant) {
     return report;
   }
   if (state.origin === null) state.origin = previousInstant;
-  // A stalled frame (longer than maxInterval, at most catchUp) runs as equal advances of at most
-  // maxInterval: the pointer input queued during the stall deposits in full.
-  let ends = [currentInstant];
-  if (decision === 'catch-up') {
+  if (decision === 'advance') {
+    advance(state, previousInstant, currentInstant, report, true);
+  } else {
+    // A stalled frame (longer than maxInterval, at most catchUp) runs as equal advances of at most
+    // maxInterval: the pointer input queued during the stall deposits in full.
     counters.catchUps += 1;
-    ends = advanceInstants(previousInstant, currentInstant, params.maxInterval);
-  }
-  let start = previousInstant;
-  let fresh = true;
-  for (let i = 0; i < ends.length; i++) {
-    fresh = !advance(state, start, ends[i], report, fresh) && fresh;
-    start = ends[i];
+    const ends = advanceInstants(previousInstant, currentInstant, params.maxInterval);
+    let start = previousInstant;
+    let fresh = true;
+    for (let i = 0; i < ends.length; i++) {
+      fresh = !advance(state, start, ends[i], report, fresh) && fresh;
+      start = ends[i];
+    }
   }
   if (report.updateTiles === 0 && report.retiredTiles === 0) counters.idleFrames += 1;
   counters.lateSteps += report.lateSteps;
