@@ -117,7 +117,7 @@ export const CREATURE = Object.freeze({
   "registers": 13,
   "roundCone": [0, 0, 0, 0, 0, 0, 0],
   "signatures": {
-    "compilerSignature": "114d180b62f4bbbc51d2b15e51903eb14222b77575c1f4da4bc1ac9c7c18189f",
+    "compilerSignature": "1dc8b55faf91afe5192b344a4086fc9162385d2d6d1804225b542d24f2ebbcb4",
     "geometryDigest": "400b0d18a2a9f6bbbfe5b441f89767f552a4f3b4c45a368d1129d632e1d2f4f1",
     "topologySignature": "330d551e8c006f84b01459c84db69ca8c43aec5bc9d9083d3e85c291be5a68bf"
   },
