@@ -128,25 +128,27 @@ def test_inspect_rejects_an_unknown_tier() -> None:
     assert done.stderr.strip() == "--tiers: unknown tier 'epic' (known: hero, repeated, distant)"
 
 
-TANGLED = REPO / "tests" / "fixtures" / "tangled-beetle.json"
+PINCER = REPO / "tests" / "fixtures" / "pincer.json"
 
 
 def test_a_valid_spec_a_build_gate_refuses_exits_3_and_writes_nothing(tmp_path: Path) -> None:
-    """The tangled beetle validates (exit 0) but its legs close four handles, so the euler gate refuses
+    """The pincer validates (exit 0) but its two claws touch and close a handle, so the euler gate refuses
     its surface: exit 3, not 2 (the spec is well formed; its shape must change), and nothing is written
-    (an earlier package and a user's file in the output folder are left as they were)."""
-    assert run_cli("validate", str(TANGLED)).returncode == 0
+    (an earlier package and a user's file in the output folder are left as they were). The pincer, and not
+    the tangled beetle of tests/test_surface_handles.py, because it refuses in 3 s: the beetle's hexapod
+    motion envelope runs first and takes 40."""
+    assert run_cli("validate", str(PINCER)).returncode == 0
     out = tmp_path / "out"
-    (out / "tangled-beetle").mkdir(parents=True)
-    (out / "tangled-beetle" / "index.js").write_text("// an earlier build\n")
+    (out / "pincer").mkdir(parents=True)
+    (out / "pincer" / "index.js").write_text("// an earlier build\n")
     (out / "notes.txt").write_text("mine")
     before = sorted(
         (p.relative_to(out).as_posix(), p.read_bytes() if p.is_file() else b"") for p in out.rglob("*")
     )
-    done = run_cli("build", str(TANGLED), "-o", str(out), "--picture", "off")
+    done = run_cli("build", str(PINCER), "-o", str(out), "--picture", "off")
     assert done.returncode == 3, done.stdout[-2000:] + done.stderr[-2000:]
-    assert f"{TANGLED}: surface.hero: surface hero: gate euler" in done.stderr
-    assert "part.leg-front-left touches part.leg-mid-left" in done.stderr
+    assert f"{PINCER}: surface.hero: surface hero: gate euler" in done.stderr
+    assert "part.claw-right touches part.claw-left" in done.stderr
     assert "Traceback" not in done.stderr
     after = sorted(
         (p.relative_to(out).as_posix(), p.read_bytes() if p.is_file() else b"") for p in out.rglob("*")

@@ -53,11 +53,31 @@ TICKS = 1000
 #: The examples and the motion fixtures (the eight-legged spider, the kangaroo: a hopper on two legs): every
 #: gate and the JS core parity run on each.
 MOTION_SPECS = [*CREATURE_EXAMPLES, *MOTION_FIXTURES]
-#: The specs whose built package's core is checked in Node (JS vs Python, allocation): every one in
-#: ``make test-full``; in ``make test`` the browser-parity subset (every locomotion family), the beetle
-#: (built anyway for the compiler-thread probe) and the spider (an octopod).
+#: The specs whose locomotion core is checked in Node (JS vs Python, allocation): every one in ``make
+#: test-full``; in ``make test`` the browser-parity subset (every locomotion family), the beetle (the
+#: compiler-thread probe's subject) and the spider (an octopod). See ``motion_core`` for which core runs.
 PACKAGE_MOTION_SUBSET = [*PARITY_EXAMPLES, "beetle.json", "fixtures/spider.json"]
 PACKAGE_MOTION_SPECS = MOTION_SPECS if TEST_FULL else PACKAGE_MOTION_SUBSET
+#: The package whose core carries another spec's motion data in ``make test`` (built for parity anyway).
+CORE_HOST = "reference/hopper.json"
+
+
+def motion_core(name: str, creature_out: Path, tmp_path: Path) -> Path:
+    """The core/index.js the Node checks run for ``name``: its own built package where the suite builds
+    that anyway (the parity subset; every spec under ``make test-full``), else CORE_HOST's core with this
+    spec's motion data and body scale in ``CREATURE``. The motion modules are the same files in every
+    package and data.js's motion is ``MotionData.to_json()`` (the first Node check asserts it for every real
+    package), so this runs the same code on the same data without extracting a surface (the beetle's
+    65,410 vertices, the spider's) that no motion check draws."""
+    if TEST_FULL or name in PARITY_EXAMPLES:
+        return build_example(name, creature_out) / "core" / "index.js"
+    spec = load_spec(spec_file(name))
+    carried = {"motion": motion_data(name).to_json(), "bodyScale": compile_rig(spec).body_scale}
+    return wrapped_core(
+        build_example(CORE_HOST, creature_out),
+        tmp_path / f"{Path(name).stem}-core.mjs",
+        f"export const CREATURE = {{ ...real.CREATURE, ...{json.dumps(carried)} }};\n",
+    )
 
 
 def motion_data(name: str) -> MotionData:
@@ -362,12 +382,12 @@ def test_the_gates_can_fail() -> None:
 
 @pytest.mark.parametrize("name", PACKAGE_MOTION_SPECS)
 def test_js_core_matches_python(name: str, creature_out: Path, tmp_path: Path) -> None:
-    package = build_example(name, creature_out)
+    core = motion_core(name, creature_out, tmp_path)
     data = motion_data(name)
     reference = {**motion_reference(data), "data": data.to_json()}
     path = tmp_path / "motion-reference.json"
     path.write_text(json.dumps(reference))
-    env = {"MOTION_CORE": str(package / "core" / "index.js"), "MOTION_REFERENCE": str(path)}
+    env = {"MOTION_CORE": str(core), "MOTION_REFERENCE": str(path)}
     done = run_node_tests("motion_core.test.mjs", env)
     assert re.search(r"\bpass 6\b", done.stdout), done.stdout
     print(f"{name}: " + "; ".join(re.findall(r"^\S+ seed \d+: worst .*$", done.stdout, re.M)))
@@ -378,16 +398,17 @@ def test_js_core_matches_python_for_the_generic_walker_type(creature_out: Path, 
     walker compiles to the octopod's motion data but for its type (tests/test_walkers.py), so its package
     with the type relabelled (a module re-exporting the core) is what a walker spider builds; the JS core
     must still take it for a walker and match Python bit for bit."""
-    package = build_example("fixtures/spider.json", creature_out)
+    spider = motion_core("fixtures/spider.json", creature_out, tmp_path)
     data = replace(motion_data("fixtures/spider.json"), type="walker")
     reference = {**motion_reference(data), "data": data.to_json()}
     path = tmp_path / "motion-reference.json"
     path.write_text(json.dumps(reference))
-    relabelled = wrapped_core(
-        package,
-        tmp_path / "walker-core.mjs",
+    relabelled = tmp_path / "walker-core.mjs"
+    relabelled.write_text(
+        f"import * as real from {json.dumps(spider.resolve().as_uri())};\n"
+        f"export * from {json.dumps(spider.resolve().as_uri())};\n"
         "export const CREATURE = "
-        "{ ...real.CREATURE, motion: { ...real.CREATURE.motion, type: 'walker' } };\n",
+        "{ ...real.CREATURE, motion: { ...real.CREATURE.motion, type: 'walker' } };\n"
     )
     env = {"MOTION_CORE": str(relabelled), "MOTION_REFERENCE": str(path)}
     done = run_node_tests("motion_core.test.mjs", env)
@@ -440,11 +461,10 @@ def windows(alloc: dict[str, Any]) -> str:
 
 
 @pytest.mark.parametrize("name", PACKAGE_MOTION_SPECS)
-def test_steady_state_steps_do_not_allocate(name: str, creature_out: Path) -> None:
+def test_steady_state_steps_do_not_allocate(name: str, creature_out: Path, tmp_path: Path) -> None:
     """V8 heap growth and garbage collections over 5000 steps of one creature after a 20000-step warm-up
     and a full collection (the cleanest of five windows: the steady state, not a late compilation)."""
-    package = build_example(name, creature_out)
-    result = allocation_probe(package / "core" / "index.js")
+    result = allocation_probe(motion_core(name, creature_out, tmp_path))
     alloc = result["allocation"]
     print(
         f"{name} ({result['type']}): {alloc['heapGrowthBytes']} bytes over {alloc['steps']} steps, "
@@ -456,12 +476,14 @@ def test_steady_state_steps_do_not_allocate(name: str, creature_out: Path) -> No
     )
 
 
-def test_the_probe_does_not_depend_on_when_the_compiler_thread_runs(creature_out: Path) -> None:
+def test_the_probe_does_not_depend_on_when_the_compiler_thread_runs(
+    creature_out: Path, tmp_path: Path
+) -> None:
     """A starved background compiler, simulated by delaying every concurrent compilation by a second, made
     the beetle's windows time unoptimised code (46 collections each, measured without the probe's flag);
     optimising on the main thread keeps the steady state clean whatever the machine's load."""
-    package = build_example("beetle.json", creature_out)
-    delayed = allocation_probe(package / "core" / "index.js", "--concurrent-recompilation-delay=1000")
+    core = motion_core("beetle.json", creature_out, tmp_path)
+    delayed = allocation_probe(core, "--concurrent-recompilation-delay=1000")
     alloc = delayed["allocation"]
     print(f"beetle, compiler delayed 1 s: {windows(alloc)}")
     assert alloc["collections"] == 0, windows(alloc)
