@@ -267,7 +267,7 @@ def measure_tier(
     mesh = ex.mesh
 
     def validate() -> tuple[list[SurfaceGate], ComponentPolicy]:
-        return surface_mesh_gates(rig, ex, field, skeleton, grid.spacing)
+        return surface_mesh_gates(rig, ex, field, skeleton, grid)
 
     t_validate, (gates, policy) = _timed(validate)
     failed = [g.name for g in gates if not g.passed]

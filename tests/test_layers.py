@@ -14,7 +14,7 @@ from creaturegen.codedigest import PACKAGE_ROOT, code_closure, imported_modules,
 
 #: Lowest first. A package (or top-level module) may import from its own layer and the layers below.
 LAYERS: tuple[frozenset[str], ...] = (
-    frozenset({"spec", "cachedir", "codedigest", "resources"}),
+    frozenset({"floatenv", "spec", "cachedir", "codedigest", "resources"}),
     frozenset({"model"}),
     frozenset({"field"}),
     frozenset({"rig"}),

@@ -113,7 +113,7 @@ def test_every_failed_mesh_gate_names_the_part_nearby() -> None:
     the body; each failed gate's detail names the part whose primitive is nearest its worst point."""
     s = rest_surface(REPO / "tests" / "fixtures" / "pincer.json", "hero")
     skeleton = build_skeleton(s.spec, s.rig)
-    gates, _ = mesh_gates.surface_mesh_gates(s.rig, s.extraction, s.field, skeleton, s.grid.spacing)
+    gates, _ = mesh_gates.surface_mesh_gates(s.rig, s.extraction, s.field, skeleton, s.grid)
     failed = {g.name: g.detail for g in gates if not g.passed}
     assert {"surfaceToZeroSet", "zeroSetToMesh", "vertexNormalAngleP99"} <= set(failed), failed
     parts = ("part.body", "part.claw-left", "part.claw-right")

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -76,7 +77,9 @@ def test_a_lower_tier_may_refine_as_far_as_the_hero_would() -> None:
         hero = make_grid(rig.slots, rig.graph, "hero", rig.slot_parts, refinement)
         for tier in ("repeated", "distant"):
             lower = make_grid(rig.slots, rig.graph, tier, rig.slot_parts, refinement + tier_offset(tier))
-            assert lower == hero, (tier, refinement, lower, hero)
+            # The same lattice node for node; only whose mesh gates judge it differs.
+            assert lower.tier == tier
+            assert replace(lower, tier="hero") == hero, (tier, refinement, lower, hero)
 
 
 def test_a_pointed_tip_starts_at_the_first_lattice_cap_and_refines_up_to_the_limit() -> None:

@@ -47,6 +47,7 @@ from .field64 import BodyField
 from .frames import radial_coordinates, rest_frames
 from .gates import SurfaceGate
 from .lattice import ValidatedMesh, validated_mesh
+from .mesh_gates import surface_error
 from .posed import PosedQuality, choice_skinner, posed_gates, posed_quality
 from .progress import Progress, stderr_progress
 from .refusal import fail_on, mesh_remedy
@@ -435,6 +436,7 @@ def _sidecar(
         },
         "posed": {**quality.describe(), "gates": [g.as_dict() for g in posed]},
         "gates": [g.as_dict() for g in stages.gates],
+        "surfaceError": surface_error(stages.gates),
         "timings": stages.timings,
     }
     if correction.contract is not None and correction.colour is not None:

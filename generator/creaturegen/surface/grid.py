@@ -55,6 +55,7 @@ class Grid:
     spacing: float
     shape: tuple[int, int, int]  # nodes per axis, each a multiple of BLOCK plus one
     limited_by: str = ""  # the part whose sagitta target the cell cap did not allow, when one did not fit
+    tier: str = FINEST_TIER  # whose mesh gates judge a mesh extracted here (mesh_gates.mesh_limits)
 
     def points(self, index: npt.NDArray[np.int64] | npt.NDArray[np.float64]) -> npt.NDArray[np.float64]:
         """World positions of integer (or half-integer) lattice coordinates (N, 3)."""
@@ -153,4 +154,4 @@ def make_grid(
             "(r × scale), or choose a coarser tier."
         )
     shape = (int(cells[0]) + 1, int(cells[1]) + 1, int(cells[2]) + 1)
-    return Grid((float(lo[0]), float(lo[1]), float(lo[2])), h, shape, limited_by)
+    return Grid((float(lo[0]), float(lo[1]), float(lo[2])), h, shape, limited_by, tier)

@@ -259,7 +259,7 @@ def _gated(
     """Every mesh gate of one lattice, after the local normal remedies when they may pass it
     (``refine_next``: a finer lattice follows unless this one passes)."""
     t = time.perf_counter()
-    gates, policy = surface_mesh_gates(rig, ex, rest_field, skeleton, grid.spacing)
+    gates, policy = surface_mesh_gates(rig, ex, rest_field, skeleton, grid)
     timings["validation"] += time.perf_counter() - t
     failed = [g.name for g in gates if not g.passed]
     progress(

@@ -7,24 +7,28 @@ nearest its worst place so the refusal says where.
 
 from __future__ import annotations
 
-from dataclasses import replace
+from dataclasses import dataclass, replace
 
 import numpy as np
 import numpy.typing as npt
 
+from ..candidates import TIERS
 from ..model.skeleton import Skeleton
 from ..rig import CompiledRig
 from .components import ComponentPolicy, component_policy
 from .extract import Extraction
 from .field64 import BodyField
 from .gates import (
+    DISTANCE_TOL,
     FACE_NORMAL_P99_DEG,
     VERTEX_NORMAL_P99_DEG,
     SurfaceGate,
     mesh_gates,
 )
+from .grid import ERROR_TARGET, FINEST_TIER, Grid
 from .handles import handle_contacts
 from .mesh import Mesh
+from .skin_tier import SUBPIXEL_PX
 from .topology import components
 
 F64 = npt.NDArray[np.float64]
@@ -55,13 +59,56 @@ NORMAL_GATES = frozenset(
 P99_GATES = frozenset({"vertexNormalAngleP99", "faceNormalAngleP99"})
 
 
+@dataclass(frozen=True)
+class MeshLimits:
+    """The thresholds of the geometric mesh gates at one tier; topology, components, angles and
+    intersections are every tier's alike."""
+
+    distance: float  # surfaceToZeroSet and zeroSetToMesh, fraction of L
+    normals: tuple[float, float, float, float]  # NORMAL_LIMITS' order, degrees
+
+
+def mesh_limits(tier: str) -> MeshLimits:
+    """A tier's mesh is judged at the fidelity its bodies are drawn at, or a lower tier would refine to
+    the hero's mesh and draw as many vertices for a body a few dozen pixels tall (it did: the distant
+    hopper drew the hero's 6,458). Distances scale with the tier's sagitta target (ERROR_TARGET: 2 and 4
+    times the hero's, 0.01 and 0.02 L), which is what its lattice spacing was chosen for; the p99 normal
+    angles are the tier's own skin tolerance (candidates TIERS: 10° at repeated, 20° at distant; the
+    angle past which a skin vertex already becomes a field vertex), face p99 twice that as at the hero.
+    The worst-vertex maxima stay the hero's: they catch a fold, which no distance makes invisible. What a
+    mesh gives up is reported with it (``surface_error``: the largest size on screen at which it stays
+    subpixel), so a tier is chosen by projected size, never drawn larger unknowingly."""
+    if tier == FINEST_TIER:
+        return MeshLimits(DISTANCE_TOL, NORMAL_LIMITS)
+    skin = TIERS[tier].skin
+    assert skin is not None, f"tier {tier} has no skin tolerance"
+    ratio = ERROR_TARGET[tier] / ERROR_TARGET[FINEST_TIER]
+    normals = (VERTEX_NORMAL_MAX_DEG, skin.normal_deg, FACE_NORMAL_MAX_DEG, 2.0 * skin.normal_deg)
+    return MeshLimits(DISTANCE_TOL * ratio, normals)
+
+
+def surface_error(gates: list[SurfaceGate]) -> dict[str, float]:
+    """What the rest mesh gives up against the zero set, for choosing a tier by projected size: the worse
+    of its two distance gates (fraction of L) and the largest size of L on screen, in pixels, at which
+    that stays under SUBPIXEL_PX (the skin representation's ``projectedSizeMaxPx`` says the same of the
+    skin's departure over the motion)."""
+    worst = max(g.value for g in gates if g.name in ("surfaceToZeroSet", "zeroSetToMesh"))
+    return {
+        "distanceMax": worst,
+        "subpixelPx": SUBPIXEL_PX,
+        "projectedSizeMaxPx": SUBPIXEL_PX / max(worst, 1e-12),
+    }
+
+
 def surface_mesh_gates(
-    rig: CompiledRig, ex: Extraction, rest_field: BodyField, skeleton: Skeleton, spacing: float
+    rig: CompiledRig, ex: Extraction, rest_field: BodyField, skeleton: Skeleton, grid: Grid
 ) -> tuple[list[SurfaceGate], ComponentPolicy]:
-    """Every mesh gate at the pipeline's thresholds, plus the component policy's (one list for the
-    build and bench/surface, so both judge a mesh the same way). When the euler gate fails, the policy
-    carries the contacts that close the handles and the gate's detail names them."""
+    """Every mesh gate at the thresholds of the lattice's tier (``mesh_limits``), plus the component
+    policy's (one list for the build and bench/surface, so both judge a mesh the same way). When the
+    euler gate fails, the policy carries the contacts that close the handles and the gate's detail names
+    them."""
     names = skeleton.names
+    limits = mesh_limits(grid.tier)
     policy = component_policy(ex.mesh, rig.slots, rig.graph, names)
     gates = mesh_gates(
         ex.mesh,
@@ -71,11 +118,13 @@ def surface_mesh_gates(
         field=rest_field.field,
         expected_components=policy.expected,
         min_angle_bound_deg=MIN_ANGLE_P1_DEG,
-        vertex_normal_max_deg=NORMAL_LIMITS[0],
-        vertex_normal_p99_deg=NORMAL_LIMITS[1],
-        face_normal_max_deg=NORMAL_LIMITS[2],
-        face_normal_p99_deg=NORMAL_LIMITS[3],
-        smooth=rest_field.smooth(CREASE_BAND_CELLS * spacing),
+        surface_tol=limits.distance,
+        coverage_tol=limits.distance,
+        vertex_normal_max_deg=limits.normals[0],
+        vertex_normal_p99_deg=limits.normals[1],
+        face_normal_max_deg=limits.normals[2],
+        face_normal_p99_deg=limits.normals[3],
+        smooth=rest_field.smooth(CREASE_BAND_CELLS * grid.spacing),
     )
     strays = f"components {list(policy.strays)} own no slot" if policy.strays else ""
     euler = next(g for g in gates if g.name == "euler")

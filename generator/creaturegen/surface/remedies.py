@@ -23,7 +23,7 @@ from .gates import (
 )
 from .grid import Grid
 from .mesh import Mesh
-from .mesh_gates import CREASE_BAND_CELLS, NORMAL_GATES, NORMAL_LIMITS, P99_GATES, surface_mesh_gates
+from .mesh_gates import CREASE_BAND_CELLS, NORMAL_GATES, P99_GATES, mesh_limits, surface_mesh_gates
 from .progress import Progress
 from .subdivide import (
     MARK_FACE_DEG,
@@ -213,13 +213,13 @@ def _judged(
         candidate.mesh,
         length_scale=rig.body_scale,
         field=rest_field.field,
-        normal_limits=NORMAL_LIMITS,
+        normal_limits=mesh_limits(grid.tier).normals,
         smooth=smooth,
     )
     partial = [g.name for g in normals if not g.passed]
     if not _may_be_no_worse(failed, partial) or (refine_next and set(partial) - P99_GATES):
         return False, (candidate, normals, ComponentPolicy(0, (), (), (), (), ()), partial)
-    again, again_policy = surface_mesh_gates(rig, candidate, rest_field, skeleton, grid.spacing)
+    again, again_policy = surface_mesh_gates(rig, candidate, rest_field, skeleton, grid)
     still = [g.name for g in again if not g.passed]
     return _no_worse(failed, still), (candidate, again, again_policy, still)
 
