@@ -23,6 +23,8 @@ from creaturegen.surface.asset import SurfaceAsset
 from creaturegen.surface.build import SurfaceBuild, build_surface
 from creaturegen.surface.correction_region import SKIN_PROGRAM
 from creaturegen.surface.glb import glb_bytes, parse_glb
+from creaturegen.surface.mesh_gates import mesh_limits
+from creaturegen.surface.sidecar import gate_from_row, gate_rows
 from creaturegen.surface.skin_tier import (
     MAX_REPORTED_PX,
     SUBPIXEL_PX,
@@ -129,6 +131,28 @@ def test_a_lower_tier_build_evaluates_the_field_only_where_the_skin_departs() ->
     hero = _built("reference/hopper.json", "hero").asset
     assert hero.colour_slots is None
     assert int(np.asarray(hero.candidate).max()) < SKIN_PROGRAM
+
+
+def test_a_distant_body_draws_a_mesh_of_its_own_fidelity() -> None:
+    """The distant tier's mesh is judged at the distant tier's limits (surface/mesh_gates.py mesh_limits),
+    so it stays on a coarser lattice than the hero's (it refined to the hero's 6,458 vertices before), and
+    the sidecar says up to which size on screen it stays subpixel."""
+    distant, hero = _built("reference/hopper.json", "distant"), _built("reference/hopper.json", "hero")
+    assert distant.asset.vertex_count < 0.35 * hero.asset.vertex_count
+    limits = mesh_limits("distant")
+    gates = {g.name: g for g in map(gate_from_row, gate_rows(distant.sidecar))}
+    assert all(g.passed for g in gates.values()), [g for g in gates.values() if not g.passed]
+    for name in ("surfaceToZeroSet", "zeroSetToMesh"):
+        assert gates[name].threshold == limits.distance
+    assert gates["vertexNormalAngleP99"].threshold == limits.normals[1]
+    error = distant.sidecar["surfaceError"]
+    assert isinstance(error, dict)
+    worst = max(gates[n].value for n in ("surfaceToZeroSet", "zeroSetToMesh"))
+    assert error["distanceMax"] == worst
+    assert error["projectedSizeMaxPx"] == pytest.approx(SUBPIXEL_PX / worst)
+    hero_error = hero.sidecar["surfaceError"]
+    assert isinstance(hero_error, dict)
+    assert hero_error["projectedSizeMaxPx"] > error["projectedSizeMaxPx"]
 
 
 def test_the_baked_colour_survives_the_glb() -> None:

@@ -202,3 +202,45 @@ def test_a_remedy_is_turned_down_early_only_when_no_full_pass_could_keep_it(
         assert not any(remedies._no_worse(failed, full) for full in supersets)
     else:
         assert remedies._no_worse(failed, some)
+
+
+def test_each_tier_judges_its_mesh_at_its_own_limits() -> None:
+    """Distances follow the sagitta targets, the p99 normal angles the tiers' skin tolerances, and each
+    lower tier accepts whatever a higher one does (so no lower tier refuses a lattice the hero passes)."""
+    from creaturegen.candidates import TIERS
+    from creaturegen.surface.grid import ERROR_TARGET
+    from creaturegen.surface.mesh_gates import NORMAL_LIMITS, mesh_limits
+    from creaturegen.surface.remedies import split_marks
+    from creaturegen.surface.subdivide import MARK_FACE_DEG, MARK_VERTEX_DEG, TAIL_MARKS
+
+    hero = mesh_limits("hero")
+    assert hero.distance == 0.005
+    assert hero.normals == NORMAL_LIMITS
+    assert split_marks("hero") == ((MARK_VERTEX_DEG, MARK_FACE_DEG), TAIL_MARKS)
+    previous = hero
+    for tier in ("repeated", "distant"):
+        limits, skin = mesh_limits(tier), TIERS[tier].skin
+        assert skin is not None
+        assert limits.distance == pytest.approx(0.005 * ERROR_TARGET[tier] / ERROR_TARGET["hero"])
+        assert limits.normals[1] == skin.normal_deg
+        assert limits.normals[3] == 2.0 * skin.normal_deg
+        assert (limits.normals[0], limits.normals[2]) == (NORMAL_LIMITS[0], NORMAL_LIMITS[2])
+        assert limits.distance > previous.distance
+        assert all(a >= b for a, b in zip(limits.normals, previous.normals, strict=True))
+        previous = limits
+
+
+def test_the_distant_first_lattice_passes_distant_gates_and_fails_the_heros() -> None:
+    """The hopper's first distant lattice (1,658 vertices): its distances pass the distant tier's 0.02 L
+    and fail the hero's 0.005 L, judged by the same function on the same mesh."""
+    from conftest import EXAMPLES, rest_surface
+    from creaturegen.surface.mesh_gates import surface_mesh_gates
+
+    s = rest_surface(EXAMPLES / "reference" / "hopper.json", "distant")
+    skeleton = build_skeleton(s.spec, s.rig)
+    assert s.grid.tier == "distant"
+    as_distant, _ = surface_mesh_gates(s.rig, s.extraction, s.field, skeleton, s.grid)
+    as_hero, _ = surface_mesh_gates(s.rig, s.extraction, s.field, skeleton, replace(s.grid, tier="hero"))
+    distances = ("surfaceToZeroSet", "zeroSetToMesh")
+    assert all(g.passed for g in as_distant if g.name in distances)
+    assert not any(g.passed for g in as_hero if g.name in distances)

@@ -21,14 +21,13 @@ from .gates import (
     SurfaceGate,
     normal_gates,
 )
-from .grid import Grid
+from .grid import FINEST_TIER, Grid
 from .mesh import Mesh
 from .mesh_gates import CREASE_BAND_CELLS, NORMAL_GATES, P99_GATES, mesh_limits, surface_mesh_gates
 from .progress import Progress
 from .subdivide import (
     MARK_FACE_DEG,
     MARK_VERTEX_DEG,
-    TAIL_MARKS,
     analytic_normals,
     split_faces,
     subdivide_to_field,
@@ -72,14 +71,15 @@ def remedied(
     only when it may pass the lattice (``_judged``)."""
     flipped_mesh, flips = flip_to_field(ex.mesh, rest_field.gradient)
     flipped = replace(ex, mesh=flipped_mesh)
+    first, tail = split_marks(grid.tier)
 
     def split(base: Extraction, flipped_too: int) -> Remedy | None:
         """``base`` split toward the field and gated against the current failures: the result if kept.
-        While a p99 gate still fails, its tail is split too (subdivide.TAIL_MARKS) and kept if no worse."""
+        While a p99 gate still fails, its tail is split too (``split_marks``) and kept if no worse."""
         best: Remedy | None = None
         against = failed
-        for marks in ((MARK_VERTEX_DEG, MARK_FACE_DEG), TAIL_MARKS):
-            if marks == TAIL_MARKS and not set(against) & P99_GATES:
+        for marks in (first, tail):
+            if marks == tail and not set(against) & P99_GATES:
                 break
             candidate, added, declined = _split_toward_field(
                 base if best is None else best[0], rest_field, marks
@@ -89,7 +89,7 @@ def remedied(
             kept, result = _judged(rig, candidate, against, rest_field, skeleton, grid, refine_next)
             what = (
                 "where the normals disagree"
-                if marks != TAIL_MARKS
+                if marks != tail
                 else "where the normals pass the p99 bounds"
             )
             lead = f"{flipped_too} edges flipped and {added} split" if flipped_too else f"{added} edges split"
@@ -112,6 +112,20 @@ def remedied(
     if failed and set(failed) <= NORMAL_GATES and not only_normals:
         return split(ex, 0) or (ex, gates, policy, failed)
     return ex, gates, policy, failed
+
+
+def split_marks(tier: str) -> tuple[tuple[float, float], tuple[float, float]]:
+    """(vertex, face) angles past which the normal remedy splits, first pass and tail pass, at ``tier``.
+    At the hero: twice the p99 bounds, then the bounds themselves (subdivide.MARK_VERTEX_DEG,
+    MARK_FACE_DEG, TAIL_MARKS). A lower tier's marks grow with its p99 bounds, since the hero's split its
+    mesh where its own gates pass (the distant quadruped: 2,034 splits for a vertex p99 of 23.8° against
+    20°, 2,050 vertices to 4,084), but never past half the maxima every tier keeps: the first pass must
+    still mark the faces a failing maximum gate counts (a generated quadruped's face maximum at distant
+    refinement 3 passed with marks at 20°, not at 80°)."""
+    limits = mesh_limits(tier).normals
+    scale = limits[1] / mesh_limits(FINEST_TIER).normals[1]
+    first = (min(MARK_VERTEX_DEG * scale, limits[0] / 2.0), min(MARK_FACE_DEG * scale, limits[2] / 2.0))
+    return first, (min(limits[1], first[0]), min(limits[3], first[1]))
 
 
 def spread_steep_weights(
