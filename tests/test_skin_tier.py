@@ -12,6 +12,7 @@ import pytest
 from conftest import EXAMPLES
 from creaturegen.candidates import TIERS
 from creaturegen.candidates.regions import SkinTolerance
+from creaturegen.creature.plan import _projected_size_max_px
 from creaturegen.field.floors import floors_for
 from creaturegen.field.sampler import sample_graph
 from creaturegen.model import layout as col
@@ -153,6 +154,12 @@ def test_a_distant_body_draws_a_mesh_of_its_own_fidelity() -> None:
     hero_error = hero.sidecar["surfaceError"]
     assert isinstance(hero_error, dict)
     assert hero_error["projectedSizeMaxPx"] > error["projectedSizeMaxPx"]
+    # CREATURE.projectedSizeMaxPx: the smaller of the mesh's and the skin's subpixel sizes.
+    skin = distant.sidecar["skinRepresentation"]
+    assert isinstance(skin, dict)
+    shipped = _projected_size_max_px(distant.sidecar)
+    assert shipped == min(error["projectedSizeMaxPx"], skin["projectedSizeMaxPx"])
+    assert _projected_size_max_px(hero.sidecar) == hero_error["projectedSizeMaxPx"] > shipped
 
 
 def test_the_baked_colour_survives_the_glb() -> None:

@@ -129,6 +129,7 @@ def build_plan(creature: CompiledCreature, surface: SurfaceBuild, spec_sha256: s
         "sizeRange": f"{1.0 - spec.genetics.size:g} to {1.0 + spec.genetics.size:g}",
         "signatures": dict(surface.signatures),
         "tier": surface.tier,
+        "subpixel": _subpixel_sentence(runtime.projected_size_max_px, surface.tier),
         "gates": [g.as_dict() for g in surface.gates],
         "representation": _representation(workload["fieldVertices"], surface.asset.vertex_count),
         "workload": workload,
@@ -195,7 +196,26 @@ def _runtime(
         k_floor=floors.k_floor,
         correction=CorrectionData(correction.DEFAULT_BUDGET, correction.EARLY_OUT, correction.GRADIENT_FLOOR),
         mesh=MeshCounts(asset.vertex_count, int(asset.indices.size // 3)),
+        projected_size_max_px=_projected_size_max_px(surface.sidecar),
     )
+
+
+def _subpixel_sentence(size: float, tier: str) -> str:
+    """The README's end of the sentence on the tier's subpixel size (``CREATURE.projectedSizeMaxPx``)."""
+    finer = list(TIERS)[: list(TIERS).index(tier)]
+    then = f"draw larger bodies with the {finer[-1]} tier's package" if finer else "the finest tier there is"
+    return f"{size:.0f} px across on screen (`CREATURE.projectedSizeMaxPx`); {then}."
+
+
+def _projected_size_max_px(sidecar: dict[str, object]) -> float:
+    """The smaller of the sidecar's two subpixel sizes: the mesh's, and the skin representation's."""
+    sizes = []
+    for key in ("surfaceError", "skinRepresentation"):
+        part = sidecar.get(key)
+        if isinstance(part, dict) and isinstance(part.get("projectedSizeMaxPx"), int | float):
+            sizes.append(float(part["projectedSizeMaxPx"]))
+    assert sizes, "the surface sidecar reports no surfaceError"
+    return min(sizes)
 
 
 def _usage(motion: MotionData) -> dict[str, str]:

@@ -84,6 +84,11 @@ class CreatureData(JsonRecord):
     k_floor: float
     correction: CorrectionData
     mesh: MeshCounts
+    projected_size_max_px: float
+    """The largest size of the body's length L on screen, in pixels, at which this tier's surface stays
+    within half a pixel of the field: the rest mesh's distance to the zero set and, at a skin-represented
+    tier, the skin's departure over the motion (assets/surface.json ``surfaceError`` and
+    ``skinRepresentation``). Draw a body larger than this with a finer tier's package."""
 
 
 @cache

@@ -87,11 +87,7 @@ def remedied(
             if not added:
                 continue
             kept, result = _judged(rig, candidate, against, rest_field, skeleton, grid, refine_next)
-            what = (
-                "where the normals disagree"
-                if marks != tail
-                else "where the normals pass the p99 bounds"
-            )
+            what = "where the normals disagree" if marks != tail else "where the normals pass the p99 bounds"
             lead = f"{flipped_too} edges flipped and {added} split" if flipped_too else f"{added} edges split"
             progress(
                 f"{lead} toward the field {what} ({declined} marked triangles declined: a midpoint there "
