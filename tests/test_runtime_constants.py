@@ -14,6 +14,7 @@ import re
 
 import pytest
 
+from creaturegen.creature.lod import HYSTERESIS, TIER_ORDER
 from creaturegen.creature.plan import DEBUG_MODES, DEFORM_STRIDE
 from creaturegen.creature.pose import POSE_ROWS
 from creaturegen.creature.runtime import CreatureData
@@ -31,6 +32,8 @@ PINNED: tuple[tuple[str, str, object], ...] = (
     ("tsl/body.js", "NO_PROGRAM", NO_PROGRAM),
     ("tsl/body.js", "SKIN_PROGRAM", SKIN_PROGRAM),
     ("tsl/material.js", "DEBUG_MODES", list(DEBUG_MODES)),
+    ("core/lod.js", "TIER_ORDER", list(TIER_ORDER)),
+    ("core/lod.js", "TIER_HYSTERESIS", HYSTERESIS),
 )
 
 #: CreatureData fields that were these constants: none may come back.
@@ -38,17 +41,19 @@ MOVED = ("pose_rows", "lcg", "no_program", "skin_program", "debug_modes", "defor
 
 
 def js_constant(source: str, name: str) -> object:
-    """The value of ``export const NAME = value;`` in ``source``: an integer literal, or a frozen array of
-    string literals (``Object.freeze(['a', 'b'])``)."""
+    """The value of ``export const NAME = value;`` in ``source``: an integer or decimal literal, or a frozen
+    array of string literals (``Object.freeze(['a', 'b'])``)."""
     found = re.findall(rf"^export const {name} = (.+);$", source, re.M)
     if len(found) != 1:
         raise AssertionError(f"{name}: {len(found)} `export const {name} = …;` lines")
     value = found[0]
     if re.fullmatch(r"-?\d+", value):
         return int(value)
+    if re.fullmatch(r"-?\d+\.\d+", value):
+        return float(value)
     frozen = re.fullmatch(r"Object\.freeze\((\[[^\]]*\])\)", value)
     if frozen is None:
-        raise AssertionError(f"{name}: not an integer or a frozen array of strings: {value}")
+        raise AssertionError(f"{name}: not a number or a frozen array of strings: {value}")
     return json.loads(frozen.group(1).replace("'", '"'))
 
 
@@ -73,7 +78,7 @@ def test_every_runtime_constant_is_the_python_one() -> None:
 @pytest.mark.parametrize(("path", "name", "value"), PINNED)
 def test_a_planted_mismatch_is_caught(path: str, name: str, value: object) -> None:
     sources = _sources()
-    planted = "Object.freeze(['off'])" if isinstance(value, list) else str(int(str(value)) + 1)
+    planted = "Object.freeze(['off'])" if isinstance(value, list) else repr(value + 1)
     line = re.compile(rf"^(export const {name} = ).+;$", re.M)
     sources[path], count = line.subn(rf"\g<1>{planted};", sources[path])
     assert count == 1
@@ -83,7 +88,7 @@ def test_a_planted_mismatch_is_caught(path: str, name: str, value: object) -> No
 def test_a_missing_or_computed_constant_is_an_error() -> None:
     with pytest.raises(AssertionError, match="0 `export const"):
         js_constant("export const OTHER = 3;\n", "DEFORM_STRIDE")
-    with pytest.raises(AssertionError, match="not an integer"):
+    with pytest.raises(AssertionError, match="not a number"):
         js_constant("export const DEFORM_STRIDE = CREATURE.deformStride;\n", "DEFORM_STRIDE")
 
 

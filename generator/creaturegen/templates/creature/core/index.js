@@ -21,3 +21,5 @@ export {
 } from './motion/providers.js';
 export { TierRefusedError, assertWaterFor, createMotion } from './motion/motion.js';
 export { derive, ticksFromSeconds } from './motion/derived.js';
+// The projected-size contract a body's tier is chosen by (CREATURE.projectedSizeMaxPx per built tier).
+export { TIER_HYSTERESIS, TIER_ORDER, chooseTier, projectedSizePx } from './lod.js';

@@ -438,3 +438,23 @@ export function toWorld(frame: ArrayLike<number>, v: ArrayLike<number>, vo: numb
 export function toLocal(frame: ArrayLike<number>, p: ArrayLike<number>, po: number, out: Vec, o: number): void;
 export function derive(data: MotionData, gravity: ArrayLike<number>): Record<string, number>;
 export function ticksFromSeconds(seconds: number, hz: number): number;
+
+/** Coarse to fine: a body is drawn by the coarsest built tier whose subpixel size covers it. */
+export const TIER_ORDER: readonly TierName[];
+/** A body moves to a coarser tier only once it is this fraction inside that tier's subpixel size. */
+export const TIER_HYSTERESIS: number;
+/** The camera fields projectedSizePx reads (a three PerspectiveCamera or OrthographicCamera has them). */
+export interface ProjectingCamera {
+  readonly isOrthographicCamera?: boolean;
+  readonly fov?: number;
+  readonly zoom?: number;
+  readonly top?: number;
+  readonly bottom?: number;
+}
+/** The body's length on screen, in pixels, from the camera's unjittered projection. */
+export function projectedSizePx(length: number, depth: number, viewportHeight: number, camera: ProjectingCamera): number;
+/**
+ * The tier for a body of `sizePx` now drawn by `current` (null: not yet drawn), among the built tiers
+ * `ceilings` (tier: its CREATURE.projectedSizeMaxPx), with hysteresis.
+ */
+export function chooseTier(sizePx: number, current: TierName | null, ceilings: Partial<Record<TierName, number>>): TierName;
