@@ -27,16 +27,16 @@ export function projectedSizePx(length, depth, viewportHeight, camera) {
  * its ceiling, and a body switches down into it only below (1 − TIER_HYSTERESIS) of it.
  */
 export function chooseTier(sizePx, current, ceilings) {
+  // No closure or array per call: a crowd asks this for every body every frame.
   let finest = null;
   for (const t of TIER_ORDER) if (t in ceilings) finest = t;
   if (finest === null) throw new Error('chooseTier: no tier is built');
-  const fits = (t, margin) => t === finest || sizePx <= ceilings[t] * margin;
-  if (current !== null && current in ceilings && fits(current, 1)) {
+  if (current !== null && current in ceilings && (current === finest || sizePx <= ceilings[current])) {
     for (const t of TIER_ORDER) {
       if (t === current) return current;
-      if (t in ceilings && fits(t, 1 - TIER_HYSTERESIS)) return t;
+      if (t in ceilings && sizePx <= ceilings[t] * (1 - TIER_HYSTERESIS)) return t;
     }
   }
-  for (const t of TIER_ORDER) if (t in ceilings && fits(t, 1)) return t;
+  for (const t of TIER_ORDER) if (t in ceilings && (t === finest || sizePx <= ceilings[t])) return t;
   return finest;
 }
