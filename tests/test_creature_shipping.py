@@ -162,12 +162,15 @@ def test_surface_asset_is_named_by_package_geometry_and_programs(hopper: Path) -
 
 
 def test_surface_path_without_a_build_report(hopper: Path, tmp_path: Path) -> None:
-    """An installed copy ships no build report: the one .glb of assets/ is the surface."""
+    """An installed copy ships no build report: the one .glb of assets/ is the surface; of several (a
+    package shipping several tiers), the one core/data.js names."""
     copy = tmp_path / hopper.name
     shutil.copytree(hopper, copy)
     (copy / REPORT_PATH).unlink()
     assert surface_path(copy) == copy / surface_path(hopper).relative_to(hopper)
     (copy / "assets" / "extra.glb").write_bytes(b"")
+    assert surface_path(copy) == copy / surface_path(hopper).relative_to(hopper)
+    (copy / "core" / "data.js").unlink()
     with pytest.raises(FileNotFoundError, match=r"expected one surface \.glb"):
         surface_path(copy)
 
@@ -187,6 +190,7 @@ def test_default_url_is_one_static_literal(hopper: Path) -> None:
     code = "\n".join(
         x for x in uses["tsl/asset.js"].splitlines() if not x.lstrip().startswith(("//", "*", "/*"))
     )
+    # One static expression per shipped surface (one tier here).
     assert code.count("import.meta.url") == 1
     text = code
     assert [m.group(2) for m in STATIC_URL.finditer(text)] == [f"../assets/{name}"]

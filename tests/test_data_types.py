@@ -111,7 +111,9 @@ EXPECTED = {
         "genetics": "ColourGenetics",
         "slotLab": "readonly Vec3[]",
         "motion": "MotionData",
+        "tiers": "readonly TierData[]",
     },
+    "TierData": {"tier": "TierName", "signatures": "CreatureSignatures", "mesh": "MeshCounts"},
     "MotionData": {
         "type": "LocomotionType",
         "hz": "number",

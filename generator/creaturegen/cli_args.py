@@ -97,15 +97,28 @@ def _add_inspect(commands: argparse._SubParsersAction[argparse.ArgumentParser]) 
     inspect.set_defaults(run=inspect_command)
 
 
+def shipped_tiers(text: str) -> tuple[str, ...]:
+    """``--tier``: one tier or a comma list, finest first (TIERS' order) whatever order it is given in."""
+    names = [t.strip() for t in text.split(",")]
+    unknown = [t for t in names if t not in TIERS]
+    if unknown:
+        raise argparse.ArgumentTypeError(f"unknown tier {unknown[0]!r} (known: {', '.join(TIERS)})")
+    if len(set(names)) != len(names):
+        raise argparse.ArgumentTypeError(f"a tier named twice in {text!r}")
+    return tuple(t for t in TIERS if t in names)
+
+
 def _add_build(commands: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
     build = commands.add_parser("build", help="validate a spec and build its package into out/<slug>/")
     build.add_argument("spec", metavar="SPEC")
     build.add_argument("-o", "--out", default="out", help="output folder (default: out)")
     build.add_argument(
         "--tier",
-        default=DEFAULT_TIER,
-        choices=tuple(TIERS),
-        help=f"creature surface tier (default {DEFAULT_TIER})",
+        default=(DEFAULT_TIER,),
+        type=shipped_tiers,
+        metavar="TIER[,TIER...]",
+        help=f"creature surface tier, or several (e.g. hero,distant: one .glb each in one package, and "
+        f"bodies move between them by their size on screen); default {DEFAULT_TIER}",
     )
     build.add_argument(
         "--backend",

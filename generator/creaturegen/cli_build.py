@@ -88,6 +88,7 @@ class _Identity:
     creature: CompiledCreature
     data: bytes
     build: SurfaceBuild
+    more: tuple[SurfaceBuild, ...] = ()  # the coarser tiers' surfaces shipped beside it (--tier hero,distant)
 
 
 def _identity(args: argparse.Namespace, name: str, spec: CharacterSpec, data: bytes) -> _Identity | int:
@@ -99,19 +100,22 @@ def _identity(args: argparse.Namespace, name: str, spec: CharacterSpec, data: by
         print_errors(name, exc.errors)
         return EXIT_INVALID
     steps = "narrow-band sampling, extraction, gates, skin weights, deformation sweeps"
-    print(f"==> surface {args.tier}: {steps}")
-    build = surface_or_exit(name, creature, args.tier, args.backend)
-    if isinstance(build, int):
-        return build
-    print_gates(build)
-    if args.posed_gates == "refuse":
-        try:
-            refuse_posed(build.sidecar, args.tier)
-        except SurfaceRejectedError as exc:
-            print_errors(name, [SpecError(f"surface.{args.tier}", str(exc))])
-            return EXIT_REFUSED
-    print_surface_summary(build)
-    return _Identity(name, creature, data, build)
+    builds: list[SurfaceBuild] = []
+    for tier in args.tier:
+        print(f"==> surface {tier}: {steps}")
+        build = surface_or_exit(name, creature, tier, args.backend)
+        if isinstance(build, int):
+            return build
+        print_gates(build)
+        if args.posed_gates == "refuse":
+            try:
+                refuse_posed(build.sidecar, tier)
+            except SurfaceRejectedError as exc:
+                print_errors(name, [SpecError(f"surface.{tier}", str(exc))])
+                return EXIT_REFUSED
+        print_surface_summary(build)
+        builds.append(build)
+    return _Identity(name, creature, data, builds[0], tuple(builds[1:]))
 
 
 #: Morphology variants drawn per identity asked for before --population gives up.
@@ -183,7 +187,7 @@ def _build_creature(args: argparse.Namespace, spec: CharacterSpec, data: bytes) 
     for one in identities:
         try:
             render = render_picture if picture else None
-            folder = build_creature(one.creature, one.data, one.build, Path(args.out), render)
+            folder = build_creature(one.creature, one.data, one.build, Path(args.out), render, one.more)
         except PackageWriteError as exc:
             print(f"{one.name}: cannot write the package: {exc}", file=sys.stderr)
             return EXIT_INVALID

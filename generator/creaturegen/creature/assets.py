@@ -52,10 +52,11 @@ def asset_plan(slug: str, geometry_digest: str, program_digest: str) -> dict[str
 CODE_FILES = ("index.js", "index.d.ts", "core/", "tsl/", "examples/", "README.md")
 
 
-def shipped_files(surface: str, picture: str | None) -> list[str]:
-    """package.json ``files``: what runs and what the README shows, nothing else. The build report and
-    the surface sidecar are diagnostics of the build; they stay in the folder and are never published."""
-    return [*CODE_FILES, surface, SPEC_PATH, *([picture] if picture else [])]
+def shipped_files(surfaces: list[str], picture: str | None) -> list[str]:
+    """package.json ``files``: what runs and what the README shows, nothing else (``surfaces``: every
+    shipped tier's .glb). The build report and the surface sidecar are diagnostics of the build; they
+    stay in the folder and are never published."""
+    return [*CODE_FILES, *surfaces, SPEC_PATH, *([picture] if picture else [])]
 
 
 def surface_path(package: Path) -> Path:
@@ -71,9 +72,26 @@ def surface_path(package: Path) -> Path:
                 raise FileNotFoundError(f"{package}: {REPORT_PATH} names a missing {relative}")
             return named
     found = sorted((package / ASSET_DIR).glob("*.glb"))
+    if len(found) > 1:
+        # Several tiers ship: the first named in core/data.js (the finest) is the package's surface.
+        named = package / ASSET_DIR / _data_surface_file(package)
+        if named.is_file():
+            return named
     if len(found) != 1:
         raise FileNotFoundError(f"{package}: expected one surface .glb in {ASSET_DIR}/, found {len(found)}")
     return found[0]
+
+
+def _data_surface_file(package: Path) -> str:
+    """CREATURE.surfaceFile as an installed package's core/data.js holds it ("" when unreadable)."""
+    try:
+        text = (package / "core" / "data.js").read_text(encoding="utf-8")
+        start = text.index("Object.freeze(") + len("Object.freeze(")
+        data: Any = json.loads(text[start : text.rindex(");")])
+    except (OSError, ValueError):
+        return ""
+    name = data.get("surfaceFile") if isinstance(data, dict) else None
+    return name if isinstance(name, str) else ""
 
 
 def shipped_spec(spec_bytes: bytes) -> bytes:

@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 import hashlib
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import Any
 
@@ -16,10 +16,27 @@ from ..surface.emit import stable_sidecar
 from ..surface.glb import glb_bytes, sidecar_bytes
 from ..surface.sidecar import posed_gate_rows
 from .assets import PICTURE_PATH, REPORT_PATH, SIDECAR_PATH, SPEC_PATH, shipped_files, shipped_spec
-from .plan import build_plan
+from .plan import TierBuild, build_plan
 
 
-def build_report(plan: dict[str, Any], surface: SurfaceBuild) -> dict[str, Any]:
+def _tier_rows(tiers: Sequence[TierBuild]) -> list[dict[str, Any]]:
+    """The build report's line per shipped tier: its file, its size and whether its gates passed."""
+    return [
+        {
+            "tier": t.data.tier,
+            "surface": t.assets["surfacePath"],
+            "vertices": t.data.mesh.vertices,
+            "projectedSizeMaxPx": t.data.projected_size_max_px,
+            "passed": t.surface.passed,
+            "posedGates": posed_gate_rows(t.surface.sidecar),
+        }
+        for t in tiers
+    ]
+
+
+def build_report(
+    plan: dict[str, Any], surface: SurfaceBuild, tiers: Sequence[TierBuild] = ()
+) -> dict[str, Any]:
     return {
         "//": header_text(str(plan["specSha256"])),
         "kind": "creature",
@@ -42,26 +59,36 @@ def build_report(plan: dict[str, Any], surface: SurfaceBuild) -> dict[str, Any]:
         # Where the package's files are: Python tools read the asset path here (creature/assets.py).
         "assets": {"surface": plan["assets"]["surfacePath"], "spec": SPEC_PATH, "sidecar": SIDECAR_PATH},
         "gates": plan["gates"],
+        # Every tier the package ships, finest first (the fields above are the first's).
+        "tiers": _tier_rows(tiers),
     }
 
 
 def creature_files(
-    creature: CompiledCreature, spec_bytes: bytes, surface: SurfaceBuild, picture: bool = False
+    creature: CompiledCreature,
+    spec_bytes: bytes,
+    surface: SurfaceBuild,
+    picture: bool = False,
+    more: Sequence[SurfaceBuild] = (),
 ) -> list[PackageFile]:
-    """Every file of the package but the picture; with ``picture`` the README shows PICTURE_PATH."""
+    """Every file of the package but the picture; with ``picture`` the README shows PICTURE_PATH. ``more``:
+    the surfaces of coarser tiers shipped beside ``surface`` (one .glb each)."""
     spec_sha256 = hashlib.sha256(spec_bytes).hexdigest()
-    built = build_plan(creature, surface, spec_sha256)
+    built = build_plan(creature, surface, spec_sha256, more)
     shown = PICTURE_PATH if picture else None
-    files_list = shipped_files(built.plan["assets"]["surfacePath"], shown)
+    files_list = shipped_files([t.assets["surfacePath"] for t in built.tiers], shown)
     plan = {**built.plan, "picture": shown, "files": files_list}
     files = render_folder("creature", plan, spec_sha256)
     # The spec (minus an unresolvable $schema): the parity job rebuilds the Python reference from it.
     files.append(PackageFile(SPEC_PATH, shipped_spec(spec_bytes)))
-    glb = glb_bytes(surface.asset, name=str(plan["slug"]), program=built.program)
-    files.append(PackageFile(str(plan["assets"]["surfacePath"]), glb))
+    for tier in built.tiers:
+        glb = glb_bytes(tier.surface.asset, name=str(plan["slug"]), program=tier.program)
+        files.append(PackageFile(tier.assets["surfacePath"], glb))
     sidecar = {"//": header_text(spec_sha256), **stable_sidecar(surface.sidecar)}
     files.append(PackageFile(SIDECAR_PATH, sidecar_bytes(sidecar)))
-    files.append(PackageFile(REPORT_PATH, (to_json(build_report(plan, surface)) + "\n").encode()))
+    files.append(
+        PackageFile(REPORT_PATH, (to_json(build_report(plan, surface, built.tiers)) + "\n").encode())
+    )
     return files
 
 
@@ -75,11 +102,12 @@ def build_creature(
     surface: SurfaceBuild,
     out_root: Path,
     render: PictureRenderer | None = None,
+    more: Sequence[SurfaceBuild] = (),
 ) -> Path:
     """Write the package and return its folder. With ``render`` (the lab's, lab/picture.py, handed in by
-    the command line) the staged package is rendered into PICTURE_PATH before it is committed. Nothing
-    is written if any step raises."""
-    files = creature_files(creature, spec_bytes, surface, render is not None)
+    the command line) the staged package is rendered into PICTURE_PATH before it is committed; ``more``
+    are coarser tiers' surfaces shipped beside ``surface``. Nothing is written if any step raises."""
+    files = creature_files(creature, spec_bytes, surface, render is not None, more)
     slug = slugify(creature.spec.name)
     if render is None:
         return write_package(out_root, slug, files, None)

@@ -8,6 +8,7 @@ lab-vs-numpy parity job meaningful.
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Any, get_args
 
@@ -32,7 +33,7 @@ from ..surface.glb import program_digest
 from ..surface.skinning import METHODS
 from .assets import asset_plan
 from .pose import POSE_ROWS
-from .runtime import CorrectionData, CreatureData, MeshCounts, data_declarations
+from .runtime import CorrectionData, CreatureData, MeshCounts, TierData, data_declarations
 from .tape import Tape, compile_tape
 
 #: The runtime's debug views (lab `setDebugMode`; tsl/material.js DEBUG_MODES); "shell" is the diagnostic
@@ -47,12 +48,24 @@ THREE_RELEASE = {"revision": "185", "peer": ">=0.185.0 <0.186.0", "pin": "0.185"
 
 
 @dataclass(frozen=True)
+class TierBuild:
+    """One shipped tier: its surface, its runtime record, its tapes and their flat data, its asset names."""
+
+    surface: SurfaceBuild
+    data: TierData
+    tapes: tuple[Tape, ...]  # candidate programs in asset order, then the full graph
+    program: tuple[float, ...]  # the tapes flat, as the .glb carries them (program_data)
+    assets: dict[str, str]  # asset_plan: surfaceFile, surfacePath, surfaceUrl
+
+
+@dataclass(frozen=True)
 class CreaturePlan:
     plan: dict[str, Any]  # what the templates print (its "runtime" is ``runtime.to_json()``)
     runtime: CreatureData
     tapes: tuple[Tape, ...]  # candidate programs in asset order, then the full graph
     skeleton: Skeleton
     program: tuple[float, ...]  # the tapes flat, as the .glb carries them (program_data)
+    tiers: tuple[TierBuild, ...]  # every shipped tier, finest first (tiers[0] is the one above)
 
 
 def program_tapes(
@@ -102,16 +115,46 @@ def program_data(tapes: list[Tape]) -> list[float]:
     return headers + body
 
 
-def build_plan(creature: CompiledCreature, surface: SurfaceBuild, spec_sha256: str) -> CreaturePlan:
-    """What the templates print for ``creature`` built with ``surface``: its skeleton and motion data as
-    the pipeline compiled them (motion/compiled.py), never rebuilt here."""
-    spec, rig, skeleton, motion = creature.spec, creature.rig, creature.skeleton, creature.motion
+def tier_build(creature: CompiledCreature, surface: SurfaceBuild) -> TierBuild:
+    """One tier's share of the package: its tapes, asset names and runtime record."""
     tapes, note = program_tapes(creature, surface.tier, surface.candidates)
-    slug = slugify(spec.name)
     program = program_data(tapes)
-    assets = asset_plan(slug, surface.signatures["geometryDigest"], program_digest(program))
-    programs = (tapes, program)
-    runtime = _runtime(spec, rig, surface, spec_sha256, skeleton, motion, programs, note, slug, assets)
+    assets = asset_plan(
+        slugify(creature.spec.name), surface.signatures["geometryDigest"], program_digest(program)
+    )
+    asset = surface.asset
+    data = TierData(
+        tier=surface.tier,
+        # The runtime names its .glb in errors and resolves it against `assetBase`.
+        surface_file=assets["surfaceFile"],
+        signatures=dict(surface.signatures),
+        # The tapes themselves ride in the .glb (surface/glb.py): a GPU buffer, not data to read.
+        program_digest=program_digest(program),
+        program_rows=len(program) // 4,
+        program_count=len(tapes),
+        full_program=len(tapes) - 1,
+        registers=max(len(t) for t in tapes),
+        candidate_note=note,
+        mesh=MeshCounts(asset.vertex_count, int(asset.indices.size // 3)),
+        projected_size_max_px=_projected_size_max_px(surface.sidecar),
+    )
+    return TierBuild(surface, data, tuple(tapes), tuple(program), assets)
+
+
+def build_plan(
+    creature: CompiledCreature,
+    surface: SurfaceBuild,
+    spec_sha256: str,
+    more: Sequence[SurfaceBuild] = (),
+) -> CreaturePlan:
+    """What the templates print for ``creature`` built with ``surface`` (and the coarser tiers ``more``,
+    shipped beside it): its skeleton and motion data as the pipeline compiled them (motion/compiled.py),
+    never rebuilt here."""
+    spec, rig, skeleton, motion = creature.spec, creature.rig, creature.skeleton, creature.motion
+    tiers = tuple(tier_build(creature, s) for s in (surface, *more))
+    first = tiers[0]
+    tapes, assets = list(first.tapes), first.assets
+    runtime = _runtime(spec, rig, spec_sha256, skeleton, motion, tuple(t.data for t in tiers))
     workload = _workload(rig, surface, runtime, tapes)
     runtime_json = runtime.to_json()
     skin = np.asarray(surface.asset.skin)  # (V, 2): method code, trust radius
@@ -129,7 +172,9 @@ def build_plan(creature: CompiledCreature, surface: SurfaceBuild, spec_sha256: s
         "sizeRange": f"{1.0 - spec.genetics.size:g} to {1.0 + spec.genetics.size:g}",
         "signatures": dict(surface.signatures),
         "tier": surface.tier,
-        "subpixel": _subpixel_sentence(runtime.projected_size_max_px, surface.tier),
+        "subpixel": _subpixel_sentence(runtime.projected_size_max_px, surface.tier, len(tiers) > 1),
+        # Every shipped tier's asset names (tsl/asset.js prints one static URL per file).
+        "tierAssets": [{"tier": t.data.tier, **t.assets} for t in tiers],
         "gates": [g.as_dict() for g in surface.gates],
         "representation": _representation(workload["fieldVertices"], surface.asset.vertex_count),
         "workload": workload,
@@ -143,34 +188,28 @@ def build_plan(creature: CompiledCreature, surface: SurfaceBuild, spec_sha256: s
             "declarations": data_declarations(),
         },
     }
-    return CreaturePlan(plan, runtime, tuple(tapes), skeleton, tuple(program))
+    return CreaturePlan(plan, runtime, first.tapes, skeleton, first.program, tiers)
 
 
 def _runtime(
     spec: CharacterSpec,
     rig: CompiledRig,
-    surface: SurfaceBuild,
     spec_sha256: str,
     skeleton: Skeleton,
     motion: MotionData,
-    programs: tuple[list[Tape], list[float]],
-    note: str,
-    slug: str,
-    assets: dict[str, Any],
+    tiers: tuple[TierData, ...],
 ) -> CreatureData:
-    """``plan["runtime"]``: the data core/data.js holds; ``programs`` are the tapes and their flat data."""
-    tapes, program = programs
+    """``plan["runtime"]``: the data core/data.js holds; its tier fields are the finest shipped tier's."""
     floors = floors_for(rig.body_scale)
-    asset = surface.asset
+    first = tiers[0]
     return CreatureData(
         name=spec.name,
-        slug=slug,
+        slug=slugify(spec.name),
         version=__version__,
         spec_sha256=spec_sha256,
-        signatures=dict(surface.signatures),
-        tier=surface.tier,
-        # The runtime names its .glb in errors and resolves it against `assetBase`.
-        surface_file=assets["surfaceFile"],
+        signatures=first.signatures,
+        tier=first.tier,
+        surface_file=first.surface_file,
         three_revision=THREE_RELEASE["revision"],
         body_scale=rig.body_scale,
         slot_count=rig.slot_count,
@@ -184,26 +223,28 @@ def _runtime(
         slot_lab=tuple((big_l, a, b) for big_l, a, b in slot_lab(rig.slots[:, col.RGB])),
         motion=motion,
         tick_rate=motion.hz,
-        # The tapes themselves ride in the .glb (surface/glb.py): a GPU buffer, not data to read.
-        program_digest=program_digest(program),
-        program_rows=len(program) // 4,
-        program_count=len(tapes),
-        full_program=len(tapes) - 1,
-        registers=max(len(t) for t in tapes),
-        candidate_note=note,
+        program_digest=first.program_digest,
+        program_rows=first.program_rows,
+        program_count=first.program_count,
+        full_program=first.full_program,
+        registers=first.registers,
+        candidate_note=first.candidate_note,
         gradient_floor=GRADIENT_FLOOR,
         tiny=float(np.finfo(np.float32).tiny),
         k_floor=floors.k_floor,
         correction=CorrectionData(correction.DEFAULT_BUDGET, correction.EARLY_OUT, correction.GRADIENT_FLOOR),
-        mesh=MeshCounts(asset.vertex_count, int(asset.indices.size // 3)),
-        projected_size_max_px=_projected_size_max_px(surface.sidecar),
+        mesh=first.mesh,
+        projected_size_max_px=first.projected_size_max_px,
+        tiers=tiers,
     )
 
 
-def _subpixel_sentence(size: float, tier: str) -> str:
+def _subpixel_sentence(size: float, tier: str, switches: bool = False) -> str:
     """The README's end of the sentence on the tier's subpixel size (``CREATURE.projectedSizeMaxPx``)."""
     finer = list(TIERS)[: list(TIERS).index(tier)]
     then = f"draw larger bodies with the {finer[-1]} tier's package" if finer else "the finest tier there is"
+    if switches:
+        then += "; the coarser tiers this package ships take over below their own sizes (`CREATURE.tiers`)"
     return f"{size:.0f} px across on screen (`CREATURE.projectedSizeMaxPx`); {then}."
 
 

@@ -42,6 +42,27 @@ class MeshCounts(JsonRecord):
 
 
 @dataclass(frozen=True, slots=True)
+class TierData(JsonRecord):
+    """One tier the package ships: its surface file and the program tapes that file carries. A population
+    draws each body with one of them and moves it between them by its size on screen (core/lod.js)."""
+
+    tier: Annotated[str, TsName("TierName")]
+    surface_file: str
+    """The tier's .glb in assets/ (its name digests geometry and programs, so tiers never collide)."""
+    signatures: Annotated[dict[str, str], TsName("CreatureSignatures")]
+    program_digest: str
+    program_rows: int
+    program_count: int
+    full_program: int
+    registers: int
+    candidate_note: str
+    mesh: MeshCounts
+    projected_size_max_px: float
+    """The largest size of L on screen, in pixels, at which this tier stays within half a pixel of the
+    field (CreatureData.projectedSizeMaxPx, for this tier)."""
+
+
+@dataclass(frozen=True, slots=True)
 class CreatureData(JsonRecord):
     """CREATURE: the build plan of this creature, as data (core/data.js)."""
 
@@ -88,7 +109,10 @@ class CreatureData(JsonRecord):
     """The largest size of the body's length L on screen, in pixels, at which this tier's surface stays
     within half a pixel of the field: the rest mesh's distance to the zero set and, at a skin-represented
     tier, the skin's departure over the motion (assets/surface.json ``surfaceError`` and
-    ``skinRepresentation``). Draw a body larger than this with a finer tier's package."""
+    ``skinRepresentation``). Draw a body larger than this with a finer tier."""
+    tiers: tuple[TierData, ...]
+    """Every tier this package ships, finest first; the first is the one the fields above describe
+    (``creaturegen build --tier hero,distant`` ships two). A population loads the tiers it is asked for."""
 
 
 @cache

@@ -21,6 +21,9 @@ Gates, all measured in the run (thresholds are relative to the body scale L wher
 - stateHash(seekTick(n)) == stateHash(stepTicks(n));
 - motion: the JS locomotion core in the page vs Python (relative 1e-12), and every planted foot as the GPU
   pose buffer draws it (rows read back, root squash/yaw/position applied) on its plant point;
+- tiers (a package built with several, ``--tier hero,distant``): the tier each body gets over a camera
+  walk vs creature/lod.py, no GPU object created by the moves, the moved bodies' surfaces, and each
+  coarser tier's silhouette vs the finest (creature_tiers.py);
 - genetics grid: 64 individuals (seeds 0..63) spawned in an 8×8 grid and stepped: every one's GPU pose
   rows (its OKLab-mutated colours and the pose its size and gait genes give) vs its Python reference, no two
   individuals alike; parity/grid.png shows them.
@@ -52,10 +55,11 @@ from .creature_population import (
 )
 from .creature_pose import hash_gate, motion_gates, pose_and_field_gates
 from .creature_skin import skin_gates
+from .creature_tiers import shipped_ceilings, tier_gates
 from .creature_views import pictures, shadow_gate
 from .report import ParityReport, adapter_gate, console_problems
 
-GATE_GROUPS = ("population", "hash", "field", "motion", "skin", "shadow", "cull", "grid")
+GATE_GROUPS = ("population", "hash", "field", "motion", "skin", "shadow", "cull", "tiers", "grid")
 
 
 def run_creature_parity(
@@ -95,6 +99,12 @@ def run_creature_parity(
         phase("field", lambda: pose_and_field_gates(page, ref, motion, report))
         phase("motion", lambda: motion_gates(page, ref, motion, report))
         phase("skin", lambda: skin_gates(page, ref, motion, report))
+        # A package shipping several tiers: bodies moved between them by their size on screen. Before the
+        # shadow gate, whose edits of the page materials make every page rebuild its bindings when next
+        # drawn (the lab's doing, which the walk's device count would charge to the tier moves); it puts
+        # instance 0 back as the lab spawned it, at the parity tick.
+        if len(shipped_ceilings(package)) > 1:
+            phase("tiers", lambda: tier_gates(page, package, report, ref.rig.body_scale, PARITY_TICK))
         phase("shadow", lambda: shadow_gate(page, package, report))
         t = time.perf_counter()
         pictures(page, package, debug_pictures, report)

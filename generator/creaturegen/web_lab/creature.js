@@ -258,6 +258,82 @@ async function main() {
     return { view: 'grid', width: w, height: h, rgba: toBase64(rgba) };
   }
 
+  // Tier walk: `bodies` bodies in a row across the view of a camera looking down −z, which dollies from
+  // `near` to `far` body lengths and back over `frames` frames. Every frame: chooseTiers from that camera
+  // (what moves bodies between tiers), one tick, one flush and one render (from the lab camera). Recorded per frame, before the
+  // tick, what the choice read (the camera's view matrix and fov, every body's posed-bounds centre and
+  // size gene) and what it gave (each body's tier and size on screen), for the Python reference
+  // (creature/lod.py) to recompute.
+  const tierCamera = new THREE.PerspectiveCamera(35, width / height, 0.05 * L, 400 * L);
+  function tierWalk(frames = 48, bodies = 6, near = 1.5, far = 24, seed = 5000) {
+    for (let i = 0; i < pop.capacity; i++) if (pop.instance(i).alive) pop.despawn(i);
+    const ids = [];
+    for (let i = 0; i < bodies; i++) ids.push(pop.spawn({ seed: seed + i, position: [(i - (bodies - 1) / 2) * 1.5 * L, 0, 0] }));
+    // Every other body idles (paused): a moved body whose pose stands still must still be deformed by its new tier.
+    for (let i = 1; i < bodies; i += 2) pop.pause(ids[i]);
+    pop.flush();
+    const records = [];
+    for (let f = 0; f < frames; f++) {
+      const t = frames === 1 ? 0 : f / (frames - 1);
+      const depth = near * Math.pow(far / near, 1 - Math.abs(2 * t - 1));  // near → far → near, geometric
+      tierCamera.position.set(0, 0.5 * L, depth * L);
+      tierCamera.rotation.set(0, 0, 0);
+      const seen = ids.map((id) => {
+        const b = pop.instance(id).bounds;
+        return { id, centre: [(b[0] + b[3]) / 2, (b[1] + b[4]) / 2, (b[2] + b[5]) / 2], size: pop.motion(id).size };
+      });
+      const moved = pop.chooseTiers(tierCamera, height);
+      const view = Array.from(tierCamera.matrixWorldInverse.elements);
+      for (const body of seen) {
+        const info = pop.instance(body.id);
+        body.tier = info.tier;
+        body.sizePx = info.sizePx;
+      }
+      pop.stepTicks(1);
+      render();  // the lab's own camera: the gate counts what the moves create, not a new camera's bindings
+      records.push({ view, fov: tierCamera.fov, zoom: tierCamera.zoom, height, moved, bodies: seen });
+    }
+    return { frames: records, stats: { tierMoves: pop.stats.tierMoves, tierMovesRefused: pop.stats.tierMovesRefused } };
+  }
+
+  // The same body drawn by two tiers, as masks: body `id` (the only live one) framed three-quarters in a
+  // `size`² target, white on black, through each tier's own page material (its positionNode: the drawn
+  // surface of that tier's deform storage), and its length on screen in pixels in that view.
+  const maskScene = new THREE.Scene();
+  const maskMaterial = new THREE.MeshBasicNodeMaterial();
+  async function tierSilhouettes(tiers, size = 256, id = 0) {
+    const masks = {};
+    const cam = portraitCamera();
+    cam.aspect = 1;
+    cam.updateProjectionMatrix();
+    const savedBackground = scene.background;
+    for (const tier of tiers) {
+      pop.setBodyTier(id, tier);
+      pop.flush();
+      const page = pop.tiers.find((t) => t.name === tier).pages.find((p) => p.mesh.count > 0);
+      const mesh = new THREE.Mesh(page.mesh.geometry, maskMaterial);
+      maskMaterial.positionNode = page.mesh.material.positionNode;
+      maskMaterial.colorNode = vec4(1, 1, 1, 1);
+      maskMaterial.needsUpdate = true;
+      mesh.count = page.mesh.count;
+      mesh.boundingSphere = page.mesh.boundingSphere;
+      maskScene.add(mesh);
+      maskScene.background = new THREE.Color(0x000000);
+      const target = targetFor(size, size);
+      renderer.setRenderTarget(target);
+      renderer.render(maskScene, cam);
+      renderer.setRenderTarget(null);
+      masks[tier] = toBase64(await readTarget(target, size, size));
+      maskScene.remove(mesh);
+    }
+    scene.background = savedBackground;
+    cam.updateMatrixWorld();
+    const b = pop.instance(id).bounds;
+    const centre = new THREE.Vector3((b[0] + b[3]) / 2, (b[1] + b[4]) / 2, (b[2] + b[5]) / 2).applyMatrix4(cam.matrixWorldInverse);
+    const sizePx = pkg.projectedSizePx(L * pop.motion(id).size, -centre.z, size, cam);
+    return { size, masks, sizePx };
+  }
+
   // The display path itself: body 0 of page 0 drawn with the shipped material's own positionNode (the
   // same node object, so the same root squash/yaw/position and normal transform the draw runs), writing
   // world position and world normal into float targets from the front camera. The parity job compares
@@ -333,6 +409,12 @@ async function main() {
       };
     },
     setTier(t) { pop.setTier(t); return t; },
+    /** The population's loaded tiers (finest first): name, subpixel size, capacity, bodies held, vertices. */
+    tierInfo() {
+      return pop.tiers.map((t) => ({ name: t.name, ceiling: t.ceiling, capacity: t.capacity, count: t.count, vertices: t.vertices }));
+    },
+    tierWalk,
+    tierSilhouettes,
     /** Hold these instances still (population.pause), or step them on again. */
     pause(ids = [0]) { for (const id of ids) pop.pause(id); return ids; },
     resume(ids = [0]) { for (const id of ids) pop.resume(id); return ids; },

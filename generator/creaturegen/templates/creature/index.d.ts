@@ -13,12 +13,16 @@ export interface PopulationOptions {
   /** Bodies per page: one material and one draw call each (default 64; clamped so that a page's deform
    *  storage fits the device's maxStorageBufferBindingSize). */
   pageSize?: number;
-  /** Must be the tier the package was built for. */
+  /** The shipped tiers to load (default: every one, CREATURE.tiers); each gets its own pages. */
+  tiers?: TierName[];
+  /** The tier spawn() puts a body in (default: the finest loaded). */
   tier?: TierName;
+  /** At most this many bodies in a tier at once (default: capacity for each). */
+  tierCapacity?: Partial<Record<TierName, number>>;
   debugMode?: DebugMode;
   /** The surface .glb's own URL (e.g. what a bundler's file loader returned for
    *  `<package>/assets/<CREATURE.surfaceFile>`). Default: the package's copy, `new URL(..., import.meta.url)`. */
-  surfaceUrl?: string | URL;
+  surfaceUrl?: string | URL | Partial<Record<TierName, string | URL>>;
   /** The folder the .glb was copied to (ending in '/'): it is fetched from `new URL(CREATURE.surfaceFile, assetBase)`;
    *  a relative base resolves against the page. Give surfaceUrl or assetBase, not both. */
   assetBase?: string | URL;
@@ -35,6 +39,8 @@ export interface SpawnOptions {
   seed?: number;
   /** Where the body's path starts; the locomotion puts it on the support, the water or at its altitude. */
   position?: [number, number, number];
+  /** The loaded tier it starts in (default: the population's `tier`). */
+  tier?: TierName;
 }
 
 export interface InstanceInfo {
@@ -52,6 +58,22 @@ export interface InstanceInfo {
   bounds: number[];
   /** Genes in [-1, 1): hue, chroma, lightness, the gait genes, then size (null when dead). */
   genome: number[] | null;
+  /** The tier drawing it (null when dead). */
+  tier: TierName | null;
+  /** Its length on screen in pixels at the last chooseTiers (null before one, or when dead). */
+  sizePx: number | null;
+}
+
+export interface PopulationTier {
+  readonly name: TierName;
+  /** Bodies it can hold (tierCapacity) and holds now. */
+  readonly capacity: number;
+  readonly count: number;
+  /** CREATURE.tiers[].projectedSizeMaxPx: the largest length on screen it draws within half a pixel. */
+  readonly ceiling: number;
+  readonly vertices: number;
+  readonly pageSize: number;
+  readonly pages: { mesh: Mesh; shell: Mesh | null }[];
 }
 
 export interface CreaturePopulation {
@@ -72,7 +94,11 @@ export interface CreaturePopulation {
     lastFrameDeformedBodies: number;
     /** Live bodies the last flush left drawn, and those it culled (cullWith). */
     lastFrameDrawnBodies: number; lastFrameCulledBodies: number;
+    /** Bodies moved between tiers so far, and moves refused because the tier was full. */
+    tierMoves: number; tierMovesRefused: number;
   };
+  /** The loaded tiers, finest first. */
+  readonly tiers: readonly PopulationTier[];
   /** One pose page: its body mesh (one draw per pass) and, once debug mode 'shell' was shown, its shell. */
   readonly pages: { mesh: Mesh; shell: Mesh | null }[];
   /** Validation plus an O(slots) write; returns the instance id. Throws when full. */
@@ -104,7 +130,16 @@ export interface CreaturePopulation {
   /** Hold a live body still (neither stepped nor re-deformed; still drawn); resume() steps it on. */
   pause(id: number): void;
   resume(id: number): void;
+  /** Move every live body into loaded tier `tier` (throws when it cannot hold them all). */
   setTier(tier: TierName): void;
+  /** Move one live body into a loaded tier, keeping its id, motion and genome; false when the tier is full. */
+  setBodyTier(id: number, tier: TierName): boolean;
+  /**
+   * Give every live body the tier its length on screen asks for (chooseTier, with hysteresis), seen from
+   * `camera` in a viewport `viewportHeight` pixels tall. Allocates nothing, creates no GPU object; returns
+   * the bodies moved.
+   */
+  chooseTiers(camera: Camera, viewportHeight: number): number;
   /** Build every shipped variant (deform compute, display, shadow) before the first visible frame. */
   warm(scene: Object3D, camera: Camera): Promise<void>;
   dispose(): void;

@@ -15,11 +15,11 @@ export const SURFACE_KEYS = Object.freeze(['geometryDigest', 'topologySignature'
  * copy, or no creaturegen asset at all). Drawing it would skin a foreign mesh with this creature's rig.
  */
 export class SurfaceMismatchError extends Error {
-  constructor(packageName, url, expected, found) {
+  constructor(packageName, url, expected, found, file = CREATURE.surfaceFile) {
     const differing = SURFACE_KEYS.filter((k) => expected[k] !== found[k]);
     super(`${packageName}: ${url} is not this package's surface: geometryDigest ${found.geometryDigest ?? '(none)'}, `
       + `expected ${expected.geometryDigest} (differing: ${differing.join(', ')}); `
-      + `serve ${CREATURE.surfaceFile} of ${packageName}@${CREATURE.version} there, or fix surfaceUrl/assetBase`);
+      + `serve ${file} of ${packageName}@${CREATURE.version} there, or fix surfaceUrl/assetBase`);
     this.name = 'SurfaceMismatchError';
     this.packageName = packageName;
     this.url = url;
@@ -47,18 +47,18 @@ export function checkThreeRevision(revision) {
   }
 }
 
-/** The signatures this package expects of its surface: its own plan's. */
-export function expectedSurface() {
-  return { ...CREATURE.signatures, tier: CREATURE.tier, programDigest: CREATURE.programDigest };
+/** The signatures this package expects of a tier's surface (`tier`: one of CREATURE.tiers; default the first). */
+export function expectedSurface(tier = CREATURE) {
+  return { ...tier.signatures, tier: tier.tier, programDigest: tier.programDigest };
 }
 
-/** Throws SurfaceMismatchError unless the .glb's asset.extras carry this package's signatures. */
-export function checkSurface(extras, url) {
-  const expected = expectedSurface();
+/** Throws SurfaceMismatchError unless the .glb's asset.extras carry the signatures of this package's `tier`. */
+export function checkSurface(extras, url, tier = CREATURE) {
+  const expected = expectedSurface(tier);
   const found = {};
   for (const key of SURFACE_KEYS) found[key] = typeof extras?.[key] === 'string' ? extras[key] : null;
   if (SURFACE_KEYS.some((k) => found[k] !== expected[k])) {
-    throw new SurfaceMismatchError(CREATURE.slug, String(url), expected, found);
+    throw new SurfaceMismatchError(CREATURE.slug, String(url), expected, found, tier.surfaceFile);
   }
 }
 
@@ -74,29 +74,30 @@ function absoluteBase(base) {
 }
 
 /**
- * Where to fetch the surface from: `surfaceUrl` (the .glb itself), else `new URL(surfaceFile, assetBase)`,
- * else `fallback()` (the package's own copy, resolved by tsl/asset.js or a bundler). Returns a string.
+ * Where to fetch the surface from: `surfaceUrl` (the .glb itself), else `new URL(file, assetBase)` (`file`:
+ * the tier's surfaceFile, default CREATURE's), else `fallback()` (the package's own copy, resolved by
+ * tsl/asset.js or a bundler). Returns a string.
  */
-export function resolveSurfaceUrl({ surfaceUrl, assetBase } = {}, fallback) {
+export function resolveSurfaceUrl({ surfaceUrl, assetBase } = {}, fallback, file = CREATURE.surfaceFile) {
   if (surfaceUrl != null && assetBase != null) {
     throw new TypeError(`${CREATURE.slug}: give surfaceUrl (the .glb's own URL) or assetBase (its folder), not both`);
   }
   if (surfaceUrl != null) return String(surfaceUrl);
-  if (assetBase != null) return new URL(CREATURE.surfaceFile, absoluteBase(assetBase)).href;
+  if (assetBase != null) return new URL(file, absoluteBase(assetBase)).href;
   return String(fallback());
 }
 
-/** Fetch, parse and check the surface at `url`: the parsed .glb (parseGlb), or a named error. */
-export async function loadSurface(url) {
+/** Fetch, parse and check the surface of `tier` (default CREATURE's own) at `url`: the parsed .glb (parseGlb), or a named error. */
+export async function loadSurface(url, tier = CREATURE) {
   const response = await fetch(url);
   if (!response.ok) {
     throw new Error(`${CREATURE.slug}: cannot load its surface ${url} (HTTP ${response.status}); `
-      + `serve ${CREATURE.surfaceFile} there, or point assetBase at the folder that holds it`);
+      + `serve ${tier.surfaceFile} there, or point assetBase at the folder that holds it`);
   }
   const surface = parseGlb(await response.arrayBuffer(), url);
-  checkSurface(surface.extras, url);
-  if (surface.program?.length !== 4 * CREATURE.programRows) {
-    throw new SurfaceMismatchError(CREATURE.slug, String(url), expectedSurface(), { ...surface.extras, programDigest: null });
+  checkSurface(surface.extras, url, tier);
+  if (surface.program?.length !== 4 * tier.programRows) {
+    throw new SurfaceMismatchError(CREATURE.slug, String(url), expectedSurface(tier), { ...surface.extras, programDigest: null }, tier.surfaceFile);
   }
   return surface;
 }

@@ -14,7 +14,15 @@ export { populationInternals };
 export function createDiagnostics(renderer, population, { maxPoints = 8192 } = {}) {
   const internals = populationInternals(population);
   const { layout, programs, geometry, records } = internals;
-  const { pages } = population;
+  // The kernels run the first loaded tier's programs over its pages: a body in another tier is refused.
+  const { pages } = internals.tiers[0];
+  const where = (id) => {
+    const found = internals.locate(id);
+    if (found.page.tier !== internals.tiers[0]) {
+      throw new Error(`diagnostics: instance ${id} is in tier ${found.tier}; these readbacks serve tier ${internals.tiers[0].name} (setBodyTier it back)`);
+    }
+    return found;
+  };
   const n = geometry.attributes.position.count;
   const rowsPerInstance = layout.maxParts * layout.rows;
   let skinState = null;
@@ -68,7 +76,7 @@ export function createDiagnostics(renderer, population, { maxPoints = 8192 } = {
      * transform): { skinned, corrected, accepted, gradient, distance } as Float32Arrays.
      */
     async readSkinned(id) {
-      const { page, index } = internals.locate(id);
+      const { page, index } = where(id);
       const s = skinKernels();
       s.instance.value = index;
       renderer.compute(s.kernels[pages.indexOf(page)]);
@@ -90,7 +98,7 @@ export function createDiagnostics(renderer, population, { maxPoints = 8192 } = {
     async probeField(id, xyz, program = layout.fullProgram) {
       const count = xyz.length / 3;
       if (count > maxPoints) throw new Error(`probeField: at most ${maxPoints} points per call (got ${count})`);
-      const { page, index } = internals.locate(id);
+      const { page, index } = where(id);
       const s = probeKernels();
       const arr = s.points.value.array;
       arr.fill(0);
@@ -107,7 +115,7 @@ export function createDiagnostics(renderer, population, { maxPoints = 8192 } = {
      * the root transform): { position, gradient, distance, accepted, colour, program } as Float32Arrays.
      */
     async readDeformed(id) {
-      const { page, index } = internals.locate(id);
+      const { page, index } = where(id);
       const floats = 4 * DEFORM_STRIDE * n;
       const raw = new Float32Array(await renderer.getArrayBufferAsync(page.deform.value, null, 4 * floats * index, 4 * floats));
       const position = new Float32Array(3 * n), gradient = new Float32Array(3 * n), colour = new Float32Array(3 * n);
@@ -127,7 +135,7 @@ export function createDiagnostics(renderer, population, { maxPoints = 8192 } = {
     },
     /** The pose rows of instance `id` as the GPU holds them (readback). */
     async readPose(id) {
-      const { page, index } = internals.locate(id);
+      const { page, index } = where(id);
       const floats = rowsPerInstance * 4;
       const buffer = await renderer.getArrayBufferAsync(page.pose.value, null, 4 * floats * index, 4 * floats);
       return new Float32Array(buffer);

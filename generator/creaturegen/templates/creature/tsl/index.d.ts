@@ -3,7 +3,7 @@
 import type {
   BufferGeometry, ComputeNode, Mesh, MeshStandardNodeMaterial, Node, StorageBufferNode, WebGPURenderer,
 } from 'three/webgpu';
-import type { CreatureData, DebugMode, ParsedSurface } from '../core/index.js';
+import type { CreatureData, DebugMode, ParsedSurface, TierName } from '../core/index.js';
 
 export type {
   CreaturePopulation, InstanceInfo, PopulationOptions, SpawnOptions,
@@ -107,3 +107,5 @@ export function surfaceGeometry(surface: ParsedSurface): BufferGeometry;
 export const SURFACE_FILE: string;
 /** The package's own copy of the surface: `new URL('../assets/<SURFACE_FILE>', import.meta.url)`, as a string. */
 export function defaultSurfaceUrl(): string;
+/** Every shipped tier's own copy of its surface (CREATURE.tiers order), as functions returning the URL. */
+export const TIER_SURFACE_URLS: Readonly<Partial<Record<TierName, () => string>>>;

@@ -12,4 +12,4 @@ export { createShellMesh } from './shell.js';
 export {
   assertThreeRevision, assertWebGPU, createCreaturePopulation, programStorage, surfaceGeometry,
 } from './population.js';
-export { SURFACE_FILE, defaultSurfaceUrl } from './asset.js';
+export { SURFACE_FILE, TIER_SURFACE_URLS, defaultSurfaceUrl } from './asset.js';

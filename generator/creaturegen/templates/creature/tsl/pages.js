@@ -11,9 +11,13 @@ import { createBodyMaterial } from './material.js';
 import { createShellMesh } from './shell.js';
 import { uploadRange } from './staging.js';
 
-/** Allocate every page of `state` (capacity bodies in pages of state.pageSize) and add their meshes. */
-export function createPages(state) {
-  const { data, capacity, pageSize, floatsPerInstance, geometry, group, vertices } = state;
+/**
+ * Allocate every page of one tier of `state` (`tier.capacity` bodies in pages of `tier.pageSize`, each
+ * drawing `tier.geometry`) and add their meshes; `index` is the first page's place in state.pages.
+ */
+export function createPages(state, tier, index) {
+  const { data, floatsPerInstance, group } = state;
+  const { capacity, pageSize, geometry, vertices } = tier;
   const pages = [];
   for (let first = 0; first < capacity; first += pageSize) {
     const size = Math.min(pageSize, capacity - first);
@@ -23,12 +27,15 @@ export function createPages(state) {
     mesh.castShadow = true;
     mesh.receiveShadow = true;
     mesh.boundingSphere = new THREE.Sphere(new THREE.Vector3(), 0);
-    mesh.name = `${data.slug}.page${pages.length}`;
+    mesh.name = `${data.slug}.${tier.name}.page${pages.length}`;
     group.add(mesh);
     const deform = deformStorage(size, vertices);
     const list = instanceList(size, 'cgList');
     const drawList = instanceList(size, 'cgDrawList');
     pages.push({
+      // The tier this page draws (its geometry, programs and layout), its place in state.pages, and the
+      // population id of the body in each slot (-1: free; a body keeps its id when it changes tier).
+      tier, index: index + pages.length, ids: new Int32Array(size).fill(-1),
       first, size, pose, mesh, staging: pose.value.array, deform, deformView: deformView(deform), kernels: new Map(), shell: null,
       // The bodies the next pre-pass runs (list, its CPU copy `listed`), and which bodies' rows changed
       // since their last pre-pass (`moved`): a body whose pose stood still is not deformed again.
@@ -52,17 +59,18 @@ export const kernelKind = (m) => (m === 'skin-only' ? 'skin-only' : 'body');
 
 // One material per (signatures, tier, mode, registers) and page: built on first use, kept for reuse.
 function materialFor(state, page, m) {
-  const { data, layout, pages, variants } = state;
+  const { variants } = state;
+  const { data, layout } = page.tier;
   const shown = m === 'shell' ? 'off' : m;
   const key = `${[data.signatures.compilerSignature, data.signatures.topologySignature, data.tier, shown, data.registers].join('|')}`
-    + `|page${pages.indexOf(page)}`;
+    + `|page${page.index}`;
   if (!variants.has(key)) variants.set(key, createBodyMaterial(layout, page.pose, page.deformView, page.drawList, shown));
   return variants.get(key);
 }
 
 function kernelFor(state, page, kind) {
   if (!page.kernels.has(kind)) {
-    const { layout, programs, records, order, vertices } = state;
+    const { layout, programs, records, order, vertices } = page.tier;
     const fns = bodyFunctions(layout, page.pose, programs);
     page.kernels.set(kind, createDeformKernel(layout, fns, {
       pose: page.pose, records, order, deform: page.deform, list: page.list, size: page.size, vertices, skinOnly: kind === 'skin-only',
@@ -73,7 +81,8 @@ function kernelFor(state, page, kind) {
 
 /** Show debug mode `m` on `page`: its material, its pre-pass kernel, and the capsule shell for 'shell'. */
 export function showMode(state, page, m) {
-  const { data, layout, group } = state;
+  const { data, group } = state;
+  const { layout } = page.tier;
   page.mesh.material = materialFor(state, page, m);
   page.kernel = kernelFor(state, page, kernelKind(m));
   if (m === 'shell' && !page.shell) {

@@ -14,14 +14,13 @@ import { createDriver } from '../core/motion/driver.js';
 import { assertWaterFor, createMotion } from '../core/motion/motion.js';
 import { createFlatGround, createGravity } from '../core/motion/providers.js';
 import { POSE_ROWS } from '../core/pose.js';
-import { checkThreeRevision, loadSurface, resolveSurfaceUrl } from '../core/surface.js';
-import { defaultSurfaceUrl } from './asset.js';
-import { layoutOf } from './body.js';
-import { DEFORM_STRIDE, dispatchDeform, vertexOrder, vertexRecords } from './deform.js';
+import { checkThreeRevision } from '../core/surface.js';
+import { dispatchDeform } from './deform.js';
 import { registerInternals } from './internals.js';
 import { checkDebugMode } from './material.js';
 import { createPages, kernelKind, showMode } from './pages.js';
-import { advance, deformAll, flush, locate, writeCurrent, writeInstance } from './staging.js';
+import { advance, clearSlot, deformAll, flush, freeSlot, locate, writeCurrent, writeInstance } from './staging.js';
+import { chooseTiers, loadTiers, moveBody, tierCount, tierNames } from './tiers.js';
 
 const SHIPPED_VARIANTS = ['off'];
 
@@ -69,10 +68,12 @@ export function assertThreeRevision(revision = THREE.REVISION) {
 }
 
 /**
- * Create a population. Options: capacity (bodies, default 64), pageSize (bodies per page and draw,
- * at most what one storage binding of the device holds: DEFORM_STRIDE·16 bytes per vertex per body,
- * default 64), tier (the built tier only), debugMode, surfaceUrl (the .glb's URL) or assetBase (the
- * folder holding CREATURE.surfaceFile; default: this package's own assets/), support (a
+ * Create a population. Options: capacity (bodies, default 64), tiers (the shipped tiers to load, default
+ * every one: CREATURE.tiers), tier (the tier spawn() puts a body in, default the finest loaded),
+ * tierCapacity ({ tier: bodies } at most in that tier, default capacity each), pageSize (bodies per page
+ * and draw, at most what one storage binding of the device holds: DEFORM_STRIDE·16 bytes per vertex per
+ * body, default 64), debugMode, surfaceUrl (the .glb's URL; { tier: URL } for several tiers) or assetBase
+ * (the folder holding the tiers' surfaceFile; default: this package's own assets/), support (a
  * SupportSurfaceProvider, default flat ground at y = 0), gravity (a gravity provider, default standard
  * gravity), water (a WaterSurfaceProvider: required for a swimmer, which is refused without one).
  */
@@ -90,35 +91,27 @@ export async function createCreaturePopulation(renderer, options = {}) {
   const gravity = options.gravity ?? createGravity();
   const water = options.water ?? null;
   assertWaterFor(data.motion.type, water, `${data.slug}: options.water`);
-  const tier = options.tier ?? data.tier;
-  if (tier !== data.tier) throw new Error(`tier: this package was built for tier ${data.tier} (got ${tier}); rebuild with --tier ${tier}`);
-  const surface = await loadSurface(resolveSurfaceUrl(options, defaultSurfaceUrl));
-  const geometry = surfaceGeometry(surface);
-  const layout = layoutOf(data);
-  const programs = programStorage(surface);
-  const records = vertexRecords(geometry);
-  const order = vertexOrder(geometry);
-  const vertices = layout.vertices;
-  // A page's deform storage is one binding: it must fit the device's maxStorageBufferBindingSize.
-  const deformBytesPerBody = vertices * DEFORM_STRIDE * 16;
-  const bindingLimit = renderer.backend.device.limits.maxStorageBufferBindingSize;
-  const fitting = Math.floor(bindingLimit / deformBytesPerBody);
-  if (fitting < 1) {
-    throw new Error(`${data.slug}: one body's deform storage (${deformBytesPerBody} bytes) exceeds this device's `
-      + `maxStorageBufferBindingSize (${bindingLimit}); build a lighter tier`);
+  const names = tierNames(data, options.tiers);
+  const spawnTier = options.tier ?? names[0];
+  if (!names.includes(spawnTier)) {
+    throw new Error(`tier: spawns go to one of the loaded tiers ${names.join(', ')} (got ${spawnTier}); `
+      + (data.tiers.some((t) => t.tier === spawnTier) ? 'add it to options.tiers' : `rebuild with --tier ${[...data.tiers.map((t) => t.tier), spawnTier].join(',')}`));
   }
-  const pageSize = Math.min(requestedPageSize, capacity, fitting);
   const floatsPerInstance = data.maxParts * POSE_ROWS * 4;
   const group = new THREE.Group();
   group.name = data.slug;
   const state = {
-    renderer, data, capacity, pageSize, floatsPerInstance, layout, programs, records, order, vertices, geometry, group,
+    renderer, data, capacity, floatsPerInstance, group,
     variants: new Map(),
     stats: {
       uploads: 0, uploadBytes: 0, lastFrameBytes: 0, spawns: 0, ticks: 0, deformDispatches: 0, lastFrameDeformedVertices: 0,
-      lastFrameDeformedBodies: 0, lastFrameDrawnBodies: 0, lastFrameCulledBodies: 0,
+      lastFrameDeformedBodies: 0, lastFrameDrawnBodies: 0, lastFrameCulledBodies: 0, tierMoves: 0, tierMovesRefused: 0,
     },
     pages: null,
+    // Where each body lives (its page in state.pages and slot there; -1: no live body has this id), its
+    // last size on screen (chooseTiers) and the call of chooseTiers that last asked for it.
+    bodyPage: new Int32Array(capacity).fill(-1), bodySlot: new Int32Array(capacity), sizePx: new Float64Array(capacity),
+    chosen: new Uint32Array(capacity), chooseEpoch: 0,
     rootRow: data.slotCount * POSE_ROWS * 4,
     // Scratch for writing rows and bounds, reused by every body every frame.
     scratch: {
@@ -130,9 +123,22 @@ export async function createCreaturePopulation(renderer, options = {}) {
     tick: 0,
     mode: checkDebugMode(options.debugMode ?? 'off'),
   };
-  const pages = createPages(state);
+  const tiers = await loadTiers(state, names, options, (surface) => ({ geometry: surfaceGeometry(surface), programs: programStorage(surface) }));
+  state.tiers = tiers;
+  state.tierByName = Object.fromEntries(tiers.map((t) => [t.name, t]));
+  // { tier: subpixel size } of the loaded tiers, as chooseTier reads them.
+  state.ceilings = Object.fromEntries(tiers.map((t) => [t.name, t.ceiling]));
+  const pages = [];
+  for (const tier of tiers) {
+    tier.pages = createPages(state, tier, pages.length);
+    pages.push(...tier.pages);
+  }
+  const first = tiers[0];
+  const { geometry, layout, programs, records, order, pageSize, deformBytesPerBody } = first;
+
   state.pages = pages;
   const { stats, variants } = state;
+  const home = state.tierByName[spawnTier];
   // The render pose of one body (update() interpolates every body into these, then writes its rows).
   const render = {
     quats: new Float64Array(4 * data.slotCount), trans: new Float64Array(3 * data.slotCount), root: new Float64Array(6),
@@ -146,10 +152,15 @@ export async function createCreaturePopulation(renderer, options = {}) {
     get tick() { return state.tick; },
     get debugMode() { return state.mode; },
     get capacity() { return capacity; },
-    /** Bodies per page (one draw each): the requested size, clamped to what one storage binding holds. */
+    /** Bodies per page (one draw each) of the finest loaded tier: the requested size, clamped to what one storage binding holds. */
     get pageSize() { return pageSize; },
-    /** GPU bytes of deform storage per body (DEFORM_STRIDE vec4 per vertex). */
+    /** GPU bytes of deform storage per body of the finest loaded tier (DEFORM_STRIDE vec4 per vertex). */
     deformBytesPerBody,
+    /** The loaded tiers, finest first: name, bodies held (count) and at most (capacity), subpixel size (ceiling), pages. */
+    tiers: tiers.map((t) => ({
+      name: t.name, capacity: t.capacity, ceiling: t.ceiling, vertices: t.vertices, pageSize: t.pageSize, pages: t.pages,
+      get count() { return tierCount(t); },
+    })),
     get count() { return pages.reduce((n, p) => n + p.alive.reduce((a, b) => a + b, 0), 0); },
     stats,
     /** The support, gravity and water providers every body of this population stands, falls and swims on. */
@@ -162,39 +173,58 @@ export async function createCreaturePopulation(renderer, options = {}) {
      * Builds its CPU motion state and writes O(slots) rows: no geometry, material, buffer or pipeline is
      * created. Its motion starts at its own tick 0.
      */
-    spawn({ seed = 0, position = [0, 0, 0] } = {}) {
+    spawn({ seed = 0, position = [0, 0, 0], tier = home.name } = {}) {
       if (!Number.isInteger(seed) || seed < 0 || seed > 0xffffffff) throw new Error(`spawn.seed: an integer in [0, 2^32) (got ${seed})`);
       if (!Array.isArray(position) || position.length !== 3 || !position.every(Number.isFinite)) {
         throw new Error('spawn.position: three finite numbers');
       }
-      for (const page of pages) {
-        for (let j = 0; j < page.size; j++) {
-          if (page.alive[j]) continue;
-          const genome = drawGenome(seed, LCG, page.genomes.subarray(GENOME_LENGTH * j, GENOME_LENGTH * (j + 1)));
-          page.motions[j] = createMotion(data.motion, LCG, { support, gravity, water, seed, position, genome });
-          genomeColours(data, genome, page.colours, 3 * data.slotCount * j);
-          page.alive[j] = 1;
-          page.paused[j] = 0;
-          page.seed[j] = seed;
-          page.spawnTick[j] = state.tick;
-          writeCurrent(state, page, j);
-          stats.spawns += 1;
-          return page.first + j;
-        }
+      const into = state.tierByName[tier];
+      if (!into) throw new Error(`spawn.tier: one of the loaded tiers ${names.join(', ')} (got ${JSON.stringify(tier)})`);
+      const id = state.bodyPage.indexOf(-1);
+      if (id < 0) throw new Error(`spawn: the population is full (capacity ${capacity}); create it with a larger capacity`);
+      const slot = freeSlot(into);
+      if (slot === null) {
+        throw new Error(`spawn: tier ${into.name} is full (tierCapacity ${into.capacity}); spawn into another tier or raise it`);
       }
-      throw new Error(`spawn: the population is full (capacity ${capacity}); create it with a larger capacity`);
+      const { page, j } = slot;
+      const genome = drawGenome(seed, LCG, page.genomes.subarray(GENOME_LENGTH * j, GENOME_LENGTH * (j + 1)));
+      page.motions[j] = createMotion(data.motion, LCG, { support, gravity, water, seed, position, genome });
+      genomeColours(data, genome, page.colours, 3 * data.slotCount * j);
+      page.alive[j] = 1;
+      page.paused[j] = 0;
+      page.seed[j] = seed;
+      page.spawnTick[j] = state.tick;
+      page.ids[j] = id;
+      state.bodyPage[id] = page.index;
+      state.bodySlot[id] = j;
+      writeCurrent(state, page, j);
+      stats.spawns += 1;
+      return id;
     },
+    /** Remove a body (its id is free for the next spawn); a dead id is left as it is. */
     despawn(id) {
       const { page, j } = locate(state, id);
-      page.alive[j] = 0;
-      page.paused[j] = 0;
-      page.motions[j] = null;
-      page.genomes.fill(0, GENOME_LENGTH * j, GENOME_LENGTH * (j + 1));
-      page.colours.fill(0, 3 * data.slotCount * j, 3 * data.slotCount * (j + 1));
-      page.staging.fill(0, j * floatsPerInstance, (j + 1) * floatsPerInstance);
-      page.moved[j] = 0;
-      page.dirtyLo = Math.min(page.dirtyLo, j);
-      page.dirtyHi = Math.max(page.dirtyHi, j);
+      if (page === null) return;
+      clearSlot(state, page, j);
+      state.bodyPage[id] = -1;
+    },
+    /**
+     * Move live body `id` into loaded tier `tier`, keeping its id, motion and genome: the next flush draws
+     * it with that tier's surface. No GPU object is created. Returns false when the tier is full.
+     */
+    setBodyTier(id, tier) {
+      const into = state.tierByName[tier];
+      if (!into) throw new Error(`setBodyTier: one of the loaded tiers ${names.join(', ')} (got ${JSON.stringify(tier)})`);
+      return moveBody(state, id, into);
+    },
+    /**
+     * Give every live body the tier its size on screen asks for (core/lod.js chooseTier over the loaded
+     * tiers' CREATURE.tiers[].projectedSizeMaxPx, with hysteresis), seen from `camera` in a viewport
+     * `viewportHeight` pixels tall (the drawing buffer's height). Call it before update() or flush(); it
+     * allocates nothing and creates no GPU object. Returns how many bodies changed tier.
+     */
+    chooseTiers(camera, viewportHeight) {
+      return chooseTiers(state, camera, viewportHeight);
     },
     /** Advance every body `n` whole fixed steps and upload the current step's pose (no interpolation). */
     stepTicks(n = 1) {
@@ -246,12 +276,12 @@ export async function createCreaturePopulation(renderer, options = {}) {
      */
     pause(id) {
       const { page, j } = locate(state, id);
-      if (!page.alive[j]) throw new Error(`pause: instance ${id} is not alive`);
+      if (page === null) throw new Error(`pause: instance ${id} is not alive`);
       page.paused[j] = 1;
     },
     resume(id) {
       const { page, j } = locate(state, id);
-      if (!page.alive[j]) throw new Error(`resume: instance ${id} is not alive`);
+      if (page === null) throw new Error(`resume: instance ${id} is not alive`);
       page.paused[j] = 0;
     },
     /** The fixed-step driver (hz, alpha, accumulator) update() uses. */
@@ -260,15 +290,20 @@ export async function createCreaturePopulation(renderer, options = {}) {
     flush: () => flush(state),
     instance(id) {
       const { page, j } = locate(state, id);
+      if (page === null) {
+        return { index: -1, alive: false, paused: false, seed: 0, spawnTick: 0, tick: null, root: null, bounds: [0, 0, 0, 0, 0, 0],
+          genome: null, tier: null, sizePx: null };
+      }
       const m = page.motions[j];
-      return { index: j, alive: page.alive[j] === 1, paused: page.paused[j] === 1, seed: page.seed[j], spawnTick: page.spawnTick[j],
-        tick: m ? m.tick : null, root: m ? Array.from(m.root) : null, bounds: Array.from(page.bounds.subarray(6 * j, 6 * j + 6)),
-        genome: m ? Array.from(page.genomes.subarray(GENOME_LENGTH * j, GENOME_LENGTH * (j + 1))) : null };
+      return { index: j, alive: true, paused: page.paused[j] === 1, seed: page.seed[j], spawnTick: page.spawnTick[j],
+        tick: m.tick, root: Array.from(m.root), bounds: Array.from(page.bounds.subarray(6 * j, 6 * j + 6)),
+        genome: Array.from(page.genomes.subarray(GENOME_LENGTH * j, GENOME_LENGTH * (j + 1))),
+        tier: page.tier.name, sizePx: state.chosen[id] === 0 ? null : state.sizePx[id] };
     },
     /** The locomotion core of a live instance (createMotion: state, gates, renderPose), or null. */
     motion(id) {
       const { page, j } = locate(state, id);
-      return page.motions[j];
+      return page === null ? null : page.motions[j];
     },
     stateHash() {
       return hashBytes(pages.map((p) => new Uint8Array(p.staging.buffer, p.staging.byteOffset, p.staging.byteLength)), state.tick);
@@ -299,8 +334,16 @@ export async function createCreaturePopulation(renderer, options = {}) {
       state.planes = new Float64Array(24 * views.length);
       state.viewsChanged = true;
     },
+    /** Move every live body into loaded tier `t` (setBodyTier for each); throws when it cannot hold them all. */
     setTier(t) {
-      if (t !== data.tier) throw new Error(`tier: this package was built for tier ${data.tier} (got ${t}); rebuild with --tier ${t}`);
+      const into = state.tierByName[t];
+      if (!into) {
+        throw new Error(`tier: this population loaded ${names.join(', ')} (got ${t}); `
+          + (data.tiers.some((x) => x.tier === t) ? 'create it with that tier in options.tiers' : `rebuild with --tier ${[...data.tiers.map((x) => x.tier), t].join(',')}`));
+      }
+      for (let id = 0; id < capacity; id++) {
+        if (state.bodyPage[id] >= 0 && !moveBody(state, id, into)) throw new Error(`setTier: tier ${t} is full (tierCapacity ${into.capacity})`);
+      }
     },
     /**
      * Build every shipped variant's pipelines (deform compute, display and shadow) and every page's deform
@@ -321,7 +364,7 @@ export async function createCreaturePopulation(renderer, options = {}) {
       for (const page of pages) deformAll(state, page);
     },
     dispose() {
-      geometry.dispose();
+      for (const tier of tiers) tier.geometry.dispose();
       for (const material of variants.values()) material.dispose();
       for (const page of pages) if (page.shell) { page.shell.geometry.dispose(); page.shell.material.dispose(); }
       group.removeFromParent();
@@ -333,14 +376,18 @@ export async function createCreaturePopulation(renderer, options = {}) {
     records,
     /** The order every page's pre-pass runs a body's vertices in (deform.js vertexOrder). */
     order,
-    /** The page holding instance `id` and its index there. */
+    /** The loaded tiers (tiers.js): the diagnostics read bodies of the first. */
+    tiers,
+    /** The page holding live instance `id`, its index there and its tier's name. */
     locate(id) {
       const { page, j } = locate(state, id);
-      return { page, index: j };
+      if (page === null) throw new Error(`instance ${id} is not alive`);
+      return { page, index: j, tier: page.tier.name };
     },
-    /** Pose rows of one instance from the CPU staging copy (what the next upload sends). */
+    /** Pose rows of one instance from the CPU staging copy (what the next upload sends; zeros when dead). */
     stagedPose(id) {
       const { page, j } = locate(state, id);
+      if (page === null) return new Float32Array(floatsPerInstance);
       return page.staging.slice(j * floatsPerInstance, (j + 1) * floatsPerInstance);
     },
     /** The debug-mode variants built so far ('off' is the shipped one). */

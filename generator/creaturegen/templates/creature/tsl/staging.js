@@ -5,15 +5,40 @@
 // between hops or a frame with no step and the same interpolation, keeps its stored surface; a culled
 // body is neither deformed nor drawn). All in place: the steady frame loop allocates nothing.
 import { WebGLCoordinateSystem, WebGPUCoordinateSystem } from 'three/webgpu';
+import { GENOME_LENGTH } from '../core/genome.js';
 import { rootBounds, writePoseRows, writeRootRows } from '../core/pose.js';
 import { dispatchDeform } from './deform.js';
 
-/** The page holding instance `id` of `state` and its index `j` there; throws for an id out of range. */
+/**
+ * The page holding instance `id` of `state` and its index `j` there ({ page: null, j: -1 } for an id no
+ * live body has); throws for an id out of range.
+ */
 export function locate(state, id) {
-  const { capacity, pages, pageSize } = state;
+  const { capacity, pages, bodyPage, bodySlot } = state;
   if (!Number.isInteger(id) || id < 0 || id >= capacity) throw new Error(`id: ${id} is not an instance of this population (0..${capacity - 1})`);
-  const page = pages[Math.floor(id / pageSize)];
-  return { page, j: id - page.first };
+  const p = bodyPage[id];
+  return p < 0 ? { page: null, j: -1 } : { page: pages[p], j: bodySlot[id] };
+}
+
+/** The first free slot of `tier`'s pages: { page, j }, or null when the tier holds `tier.capacity` bodies. */
+export function freeSlot(tier) {
+  for (const page of tier.pages) for (let j = 0; j < page.size; j++) if (!page.alive[j]) return { page, j };
+  return null;
+}
+
+/** Empty slot `j` of `page` (its rows zeroed and uploaded: the root row's alive flag with them). */
+export function clearSlot(state, page, j) {
+  const { data, floatsPerInstance } = state;
+  page.alive[j] = 0;
+  page.paused[j] = 0;
+  page.motions[j] = null;
+  page.ids[j] = -1;
+  page.genomes.fill(0, GENOME_LENGTH * j, GENOME_LENGTH * (j + 1));
+  page.colours.fill(0, 3 * data.slotCount * j, 3 * data.slotCount * (j + 1));
+  page.staging.fill(0, j * floatsPerInstance, (j + 1) * floatsPerInstance);
+  page.moved[j] = 0;
+  page.dirtyLo = Math.min(page.dirtyLo, j);
+  page.dirtyHi = Math.max(page.dirtyHi, j);
 }
 
 /**

@@ -172,6 +172,28 @@ export const CREATURE = Object.freeze({
   "threeRevision": "185",
   "tickRate": 60,
   "tier": "hero",
+  "tiers": [
+    {
+      "candidateNote": "",
+      "fullProgram": 64,
+      "mesh": {
+        "triangles": 12912,
+        "vertices": 6458
+      },
+      "programCount": 65,
+      "programDigest": "d2dd1447e2aab56c0711c1dc757bd42b26660b733e7052c6ff85529c2a620a44",
+      "programRows": 646,
+      "projectedSizeMaxPx": 186.69647541568403,
+      "registers": 13,
+      "signatures": {
+        "compilerSignature": "7f6f8fe10b4a63e84bed7b2ac4f02803fd81a39763fcefd3af42892653ab89e9",
+        "geometryDigest": "400b0d18a2a9f6bbbfe5b441f89767f552a4f3b4c45a368d1129d632e1d2f4f1",
+        "topologySignature": "330d551e8c006f84b01459c84db69ca8c43aec5bc9d9083d3e85c291be5a68bf"
+      },
+      "surfaceFile": "hopper-squash-core-09a117dd9d71.glb",
+      "tier": "hero"
+    }
+  ],
   "tiny": 1.1754943508222875e-38,
   "version": "0.1.0"
 });

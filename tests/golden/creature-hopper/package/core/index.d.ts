@@ -201,6 +201,29 @@ export interface MeshCounts {
   readonly triangles: number;
 }
 
+/**
+ * One tier the package ships: its surface file and the program tapes that file carries. A population draws
+ * each body with one of them and moves it between them by its size on screen (core/lod.js).
+ */
+export interface TierData {
+  readonly tier: TierName;
+  /** The tier's .glb in assets/ (its name digests geometry and programs, so tiers never collide). */
+  readonly surfaceFile: string;
+  readonly signatures: CreatureSignatures;
+  readonly programDigest: string;
+  readonly programRows: number;
+  readonly programCount: number;
+  readonly fullProgram: number;
+  readonly registers: number;
+  readonly candidateNote: string;
+  readonly mesh: MeshCounts;
+  /**
+   * The largest size of L on screen, in pixels, at which this tier stays within half a pixel of the field
+   * (CreatureData.projectedSizeMaxPx, for this tier).
+   */
+  readonly projectedSizeMaxPx: number;
+}
+
 /** CREATURE: the build plan of this creature, as data (core/data.js). */
 export interface CreatureData {
   readonly name: string;
@@ -247,9 +270,14 @@ export interface CreatureData {
    * The largest size of the body's length L on screen, in pixels, at which this tier's surface stays within
    * half a pixel of the field: the rest mesh's distance to the zero set and, at a skin-represented tier, the
    * skin's departure over the motion (assets/surface.json `surfaceError` and `skinRepresentation`). Draw a
-   * body larger than this with a finer tier's package.
+   * body larger than this with a finer tier.
    */
   readonly projectedSizeMaxPx: number;
+  /**
+   * Every tier this package ships, finest first; the first is the one the fields above describe (`creaturegen
+   * build --tier hero,distant` ships two). A population loads the tiers it is asked for.
+   */
+  readonly tiers: readonly TierData[];
 }
 
 export const CREATURE: CreatureData;
@@ -310,7 +338,7 @@ export type SurfaceSignatures = Record<SurfaceKey, string | null>;
 export const SURFACE_KEYS: readonly SurfaceKey[];
 /** The fetched .glb is not this package's surface: `expected` are the package's signatures, `found` the file's. */
 export class SurfaceMismatchError extends Error {
-  constructor(packageName: string, url: string, expected: SurfaceSignatures, found: SurfaceSignatures);
+  constructor(packageName: string, url: string, expected: SurfaceSignatures, found: SurfaceSignatures, file?: string);
   readonly name: 'SurfaceMismatchError';
   readonly packageName: string;
   readonly url: string;
@@ -327,14 +355,17 @@ export class ThreeRevisionError extends Error {
 }
 /** Throws ThreeRevisionError unless `revision` (three's REVISION) is CREATURE.threeRevision. */
 export function checkThreeRevision(revision: string | number): void;
-export function expectedSurface(): SurfaceSignatures;
-/** Throws SurfaceMismatchError unless `extras` (a .glb's asset.extras) carry this package's signatures. */
-export function checkSurface(extras: Record<string, unknown> | null | undefined, url: string | URL): void;
-/** Where the surface comes from: `surfaceUrl`, else `new URL(CREATURE.surfaceFile, assetBase)` (a relative
- * base resolves against the page), else `fallback()`. Both options at once is a TypeError. */
-export function resolveSurfaceUrl(options: { surfaceUrl?: string | URL | null; assetBase?: string | URL | null } | undefined, fallback: () => string | URL): string;
-/** Fetch, parse and check the surface: throws on HTTP errors, a non-glTF body, or SurfaceMismatchError. */
-export function loadSurface(url: string | URL): Promise<ParsedSurface>;
+/** The signatures of a shipped tier's surface (`tier`: one of CREATURE.tiers; default CREATURE, the first). */
+export function expectedSurface(tier?: TierData): SurfaceSignatures;
+/** Throws SurfaceMismatchError unless `extras` (a .glb's asset.extras) carry the signatures of `tier`'s surface. */
+export function checkSurface(extras: Record<string, unknown> | null | undefined, url: string | URL, tier?: TierData): void;
+/** Where a surface comes from: `surfaceUrl`, else `new URL(file, assetBase)` (`file` defaults to
+ * CREATURE.surfaceFile; a relative base resolves against the page), else `fallback()`. Both options at once is
+ * a TypeError. */
+export function resolveSurfaceUrl(options: { surfaceUrl?: string | URL | null; assetBase?: string | URL | null } | undefined, fallback: () => string | URL, file?: string): string;
+/** Fetch, parse and check `tier`'s surface (default CREATURE's): throws on HTTP errors, a non-glTF body, or
+ * SurfaceMismatchError. */
+export function loadSurface(url: string | URL, tier?: TierData): Promise<ParsedSurface>;
 
 export interface GravityProvider {
   /** Gravity (m/s²) at sim time `time` into `out`. */
