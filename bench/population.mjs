@@ -65,18 +65,33 @@ function topCamera(fraction) {
   return camera;
 }
 
+// A package shipping several tiers: a perspective camera dollying over the grid, every frame asking
+// chooseTiers before update() (what a crowd with levels of detail runs), so bodies keep moving between tiers.
+let perFrame = null;
+const walkCamera = new THREE.PerspectiveCamera(35, 16 / 9, 0.05 * L, 1000 * L);
+let walkFrame = 0;
+function walk() {
+  const t = (walkFrame++ % 240) / 240;
+  walkCamera.position.set(0, 2 * L, (4 + 60 * (0.5 - 0.5 * Math.cos(2 * Math.PI * t))) * L);
+  pop.chooseTiers(walkCamera, 720);
+}
+
 const scenarios = {
-  moving: () => { pop.cullWith(); for (let i = 0; i < options.bodies; i++) pop.resume(i); },
-  'half-paused': () => { pop.cullWith(); for (let i = 0; i < options.bodies; i++) (i % 2 ? pop.resume(i) : pop.pause(i)); },
-  'culled-moving': () => { pop.cullWith(topCamera(options.inView)); for (let i = 0; i < options.bodies; i++) pop.resume(i); },
-  'culled-half-paused': () => { pop.cullWith(topCamera(options.inView)); for (let i = 0; i < options.bodies; i++) (i % 2 ? pop.resume(i) : pop.pause(i)); },
+  moving: () => { perFrame = null; pop.cullWith(); for (let i = 0; i < options.bodies; i++) pop.resume(i); },
+  'half-paused': () => { perFrame = null; pop.cullWith(); for (let i = 0; i < options.bodies; i++) (i % 2 ? pop.resume(i) : pop.pause(i)); },
+  'culled-moving': () => { perFrame = null; pop.cullWith(topCamera(options.inView)); for (let i = 0; i < options.bodies; i++) pop.resume(i); },
+  'culled-half-paused': () => { perFrame = null; pop.cullWith(topCamera(options.inView)); for (let i = 0; i < options.bodies; i++) (i % 2 ? pop.resume(i) : pop.pause(i)); },
 };
+if (data.tiers.length > 1) {
+  scenarios['tier-walk'] = () => { perFrame = walk; pop.cullWith(); for (let i = 0; i < options.bodies; i++) pop.resume(i); };
+}
 
 const dt = 1 / data.tickRate;
 /** `n` frames of one tick each: the measured loop, its own function so V8 optimises it in the warm-up. */
 function frames(n, times) {
   for (let f = 0; f < n; f++) {
     const t0 = times ? performance.now() : 0;
+    if (perFrame !== null) perFrame();
     pop.update(dt);
     if (times) times.push(performance.now() - t0);
     uploaded();
@@ -98,6 +113,7 @@ function cost(name) {
     usPerBodyPerFrame: { p50: perBody(quantile(times, 0.5)), p95: perBody(quantile(times, 0.95)) },
     drawnBodies: pop.stats.lastFrameDrawnBodies, deformedBodies: pop.stats.lastFrameDeformedBodies,
     dispatchesPerFrame: (dispatches - before) / options.frames,
+    tierMoves: pop.stats.tierMoves, bodiesPerTier: Object.fromEntries(pop.tiers.map((t) => [t.name, t.count])),
   };
 }
 
@@ -128,6 +144,8 @@ const result = {
   // One dispatch per vertex path of the body (tsl/deform.js vertexOrder) per page whose bodies moved.
   deformKernelsPerPage: pop.pages[0].kernel.kernels.length, node: process.version, v8Flags: process.execArgv, options,
   scenarios: Object.fromEntries(Object.keys(scenarios).map((name) => [name, cost(name)])),
-  allocation: await allocations(options.allocScenarios ?? ['moving', 'culled-half-paused']),
+  tiers: pop.tiers.map((t) => ({ name: t.name, vertices: t.vertices, ceiling: t.ceiling })),
+  allocation: await allocations(options.allocScenarios
+    ?? ['moving', 'culled-half-paused', ...(data.tiers.length > 1 ? ['tier-walk'] : [])]),
 };
 console.log(JSON.stringify(result));

@@ -45,3 +45,21 @@ def test_population_benchmark_smoke(creature_out: Path, tmp_path: Path) -> None:
     assert all(w["long"]["frames"] == 3 * w["frames"] for w in report["allocation"])
     assert len(report["targets"]) == 4
     assert all(isinstance(t["met"], bool) for t in report["targets"])
+
+
+def test_population_benchmark_walks_a_two_tier_crowd(creature_out: Path, tmp_path: Path) -> None:
+    """A package shipping hero and distant: the tier-walk scenario (chooseTiers every frame under a
+    dollying camera) moves bodies between the tiers and has its allocation window probed."""
+    bench = load_bench("population")
+    package = build_example("reference/hopper.json", creature_out, "hero,distant")
+    out = tmp_path / "population.json"
+    sizes = ["--bodies", str(BODIES), "--page-size", str(PAGE_SIZE)]
+    frames = ["--warm-frames", "60", "--frames", "60", "--alloc-warm", "20", "--alloc-frames", "10"]
+    assert bench.main([str(package), "--out", str(out), *sizes, *frames]) == 0
+    report = json.loads(out.read_text())
+    assert [t["name"] for t in report["tiers"]] == ["hero", "distant"]
+    walk = report["scenarios"]["tier-walk"]
+    assert walk["tierMoves"] > 0
+    assert sum(walk["bodiesPerTier"].values()) == BODIES
+    assert "tier-walk" in {w["scenario"] for w in report["allocation"]}
+    assert any("tier-walk" in t["name"] for t in report["targets"])

@@ -13,8 +13,11 @@ from __future__ import annotations
 
 import hashlib
 import json
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
+
+from ..model.record import JsonRecord
 
 #: Folder of the package's data files, relative to the package root.
 ASSET_DIR = "assets"
@@ -40,12 +43,22 @@ def surface_file(slug: str, geometry_digest: str, program_digest: str) -> str:
     return f"{slug}-{both[:DIGEST_DIGITS]}.glb"
 
 
-def asset_plan(slug: str, geometry_digest: str, program_digest: str) -> dict[str, str]:
+@dataclass(frozen=True, slots=True)
+class AssetNames(JsonRecord):
+    """One surface file: its name, its path in the package, and the URL relative to a module one folder
+    below the root (tsl/, core/), the static literal of its ``new URL(..., import.meta.url)``."""
+
+    surface_file: str
+    surface_path: str
+    surface_url: str
+
+
+def asset_plan(slug: str, geometry_digest: str, program_digest: str) -> AssetNames:
     """What templates print about the assets: the file name, its path in the package, and the URL
     relative to a module one folder below the root (tsl/, core/), as the one static literal of the
     ``new URL(..., import.meta.url)`` expression that asset-aware bundlers look for."""
     name = surface_file(slug, geometry_digest, program_digest)
-    return {"surfaceFile": name, "surfacePath": f"{ASSET_DIR}/{name}", "surfaceUrl": f"../{ASSET_DIR}/{name}"}
+    return AssetNames(name, f"{ASSET_DIR}/{name}", f"../{ASSET_DIR}/{name}")
 
 
 #: The code and docs every package ships (package.json "files"; npm adds package.json and README.md).

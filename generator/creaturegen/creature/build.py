@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 import hashlib
 from collections.abc import Callable, Sequence
 from pathlib import Path
@@ -16,6 +17,7 @@ from ..surface.emit import stable_sidecar
 from ..surface.glb import glb_bytes, sidecar_bytes
 from ..surface.sidecar import posed_gate_rows
 from .assets import PICTURE_PATH, REPORT_PATH, SIDECAR_PATH, SPEC_PATH, shipped_files, shipped_spec
+from .package_plan import PackagePlan
 from .plan import TierBuild, build_plan
 
 
@@ -24,7 +26,7 @@ def _tier_rows(tiers: Sequence[TierBuild]) -> list[dict[str, Any]]:
     return [
         {
             "tier": t.data.tier,
-            "surface": t.assets["surfacePath"],
+            "surface": t.assets.surface_path,
             "vertices": t.data.mesh.vertices,
             "projectedSizeMaxPx": t.data.projected_size_max_px,
             "passed": t.surface.passed,
@@ -35,21 +37,21 @@ def _tier_rows(tiers: Sequence[TierBuild]) -> list[dict[str, Any]]:
 
 
 def build_report(
-    plan: dict[str, Any], surface: SurfaceBuild, tiers: Sequence[TierBuild] = ()
-) -> dict[str, Any]:
+    plan: PackagePlan, surface: SurfaceBuild, tiers: Sequence[TierBuild] = ()
+) -> dict[str, object]:
     return {
-        "//": header_text(str(plan["specSha256"])),
+        "//": header_text(plan.spec_sha256),
         "kind": "creature",
-        "name": plan["name"],
-        "package": plan["slug"],
-        "compilerVersion": plan["version"],
-        "specSha256": plan["specSha256"],
-        "signatures": plan["signatures"],
-        "tier": plan["tier"],
-        "workload": plan["workload"],
-        "methods": plan["methods"],
-        "debugModes": plan["types"]["debugMode"],
-        "candidateNote": plan["runtime"]["candidateNote"],
+        "name": plan.name,
+        "package": plan.slug,
+        "compilerVersion": plan.version,
+        "specSha256": plan.spec_sha256,
+        "signatures": plan.signatures,
+        "tier": plan.tier,
+        "workload": plan.workload.to_json(),
+        "methods": plan.methods,
+        "debugModes": list(plan.types.debug_mode),
+        "candidateNote": plan.runtime.candidate_note,
         "surface": {
             "passed": surface.passed,
             "counts": surface.sidecar.get("counts"),
@@ -57,8 +59,8 @@ def build_report(
             "posedGates": posed_gate_rows(surface.sidecar),
         },
         # Where the package's files are: Python tools read the asset path here (creature/assets.py).
-        "assets": {"surface": plan["assets"]["surfacePath"], "spec": SPEC_PATH, "sidecar": SIDECAR_PATH},
-        "gates": plan["gates"],
+        "assets": {"surface": plan.assets.surface_path, "spec": SPEC_PATH, "sidecar": SIDECAR_PATH},
+        "gates": list(plan.gates),
         # Every tier the package ships, finest first (the fields above are the first's).
         "tiers": _tier_rows(tiers),
     }
@@ -76,14 +78,14 @@ def creature_files(
     spec_sha256 = hashlib.sha256(spec_bytes).hexdigest()
     built = build_plan(creature, surface, spec_sha256, more)
     shown = PICTURE_PATH if picture else None
-    files_list = shipped_files([t.assets["surfacePath"] for t in built.tiers], shown)
-    plan = {**built.plan, "picture": shown, "files": files_list}
-    files = render_folder("creature", plan, spec_sha256)
+    files_list = shipped_files([t.assets.surface_path for t in built.tiers], shown)
+    plan = dataclasses.replace(built.plan, picture=shown, files=tuple(files_list))
+    files = render_folder("creature", plan.to_json(), spec_sha256)
     # The spec (minus an unresolvable $schema): the parity job rebuilds the Python reference from it.
     files.append(PackageFile(SPEC_PATH, shipped_spec(spec_bytes)))
     for tier in built.tiers:
-        glb = glb_bytes(tier.surface.asset, name=str(plan["slug"]), program=tier.program)
-        files.append(PackageFile(tier.assets["surfacePath"], glb))
+        glb = glb_bytes(tier.surface.asset, name=plan.slug, program=tier.program)
+        files.append(PackageFile(tier.assets.surface_path, glb))
     sidecar = {"//": header_text(spec_sha256), **stable_sidecar(surface.sidecar)}
     files.append(PackageFile(SIDECAR_PATH, sidecar_bytes(sidecar)))
     files.append(

@@ -1,6 +1,6 @@
 """The creature build plan: every number the package's runtime needs, computed once, as plain JSON data.
 
-Templates print this plan and nothing else. ``plan["runtime"]`` (the JSON of the typed CreatureData record,
+Templates print this plan (its JSON) and nothing else. ``plan.runtime`` (the typed CreatureData record,
 creature/runtime.py) becomes core/data.js; the Python reference (motion/simulate.py, creature/pose.py,
 creature/reference.py) reads the same rig, skeleton, motion record and tapes, which is what makes the
 lab-vs-numpy parity job meaningful.
@@ -10,7 +10,7 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from dataclasses import dataclass
-from typing import Any, get_args
+from typing import get_args
 
 import numpy as np
 
@@ -31,7 +31,8 @@ from ..surface.build import SurfaceBuild
 from ..surface.correction_region import NO_PROGRAM, SKIN_PROGRAM
 from ..surface.glb import program_digest
 from ..surface.skinning import METHODS
-from .assets import asset_plan
+from .assets import AssetNames, asset_plan
+from .package_plan import PackagePlan, ThreeRelease, TierAssets, TypeUnions, Usage, Workload
 from .pose import POSE_ROWS
 from .runtime import CorrectionData, CreatureData, MeshCounts, TierData, data_declarations
 from .tape import Tape, compile_tape
@@ -44,7 +45,7 @@ DEBUG_MODES = ("off", "skin-only", "distance", "weights", "normals", "candidates
 DEFORM_STRIDE = 3
 #: The three.js release the templates are written against: TSL names and node semantics move between
 #: releases, so the package pins its peer to it and refuses another REVISION at run time.
-THREE_RELEASE = {"revision": "185", "peer": ">=0.185.0 <0.186.0", "pin": "0.185", "types": "0.185"}
+THREE_RELEASE = ThreeRelease(revision="185", peer=">=0.185.0 <0.186.0", pin="0.185", types="0.185")
 
 
 @dataclass(frozen=True)
@@ -55,12 +56,12 @@ class TierBuild:
     data: TierData
     tapes: tuple[Tape, ...]  # candidate programs in asset order, then the full graph
     program: tuple[float, ...]  # the tapes flat, as the .glb carries them (program_data)
-    assets: dict[str, str]  # asset_plan: surfaceFile, surfacePath, surfaceUrl
+    assets: AssetNames
 
 
 @dataclass(frozen=True)
 class CreaturePlan:
-    plan: dict[str, Any]  # what the templates print (its "runtime" is ``runtime.to_json()``)
+    plan: PackagePlan  # what the templates print (as its JSON; its runtime is ``runtime``)
     runtime: CreatureData
     tapes: tuple[Tape, ...]  # candidate programs in asset order, then the full graph
     skeleton: Skeleton
@@ -126,7 +127,7 @@ def tier_build(creature: CompiledCreature, surface: SurfaceBuild) -> TierBuild:
     data = TierData(
         tier=surface.tier,
         # The runtime names its .glb in errors and resolves it against `assetBase`.
-        surface_file=assets["surfaceFile"],
+        surface_file=assets.surface_file,
         signatures=dict(surface.signatures),
         # The tapes themselves ride in the .glb (surface/glb.py): a GPU buffer, not data to read.
         program_digest=program_digest(program),
@@ -156,38 +157,31 @@ def build_plan(
     tapes, assets = list(first.tapes), first.assets
     runtime = _runtime(spec, rig, spec_sha256, skeleton, motion, tuple(t.data for t in tiers))
     workload = _workload(rig, surface, runtime, tapes)
-    runtime_json = runtime.to_json()
     skin = np.asarray(surface.asset.skin)  # (V, 2): method code, trust radius
-    plan: dict[str, Any] = {
-        "name": spec.name,
-        "slug": runtime.slug,
-        "version": __version__,
-        "specSha256": spec_sha256,
-        "runtime": runtime_json,
-        "assets": assets,
-        "three": THREE_RELEASE,
-        "usage": _usage(motion),
-        # The package README's gait-gene line (each gene scales its fields together).
-        "genes": "; ".join(" with ".join(g) for g in motion.genes.fields) or "nothing (no locomotion)",
-        "sizeRange": f"{1.0 - spec.genetics.size:g} to {1.0 + spec.genetics.size:g}",
-        "signatures": dict(surface.signatures),
-        "tier": surface.tier,
-        "subpixel": _subpixel_sentence(runtime.projected_size_max_px, surface.tier, len(tiers) > 1),
-        # Every shipped tier's asset names (tsl/asset.js prints one static URL per file).
-        "tierAssets": [{"tier": t.data.tier, **t.assets} for t in tiers],
-        "gates": [g.as_dict() for g in surface.gates],
-        "representation": _representation(workload["fieldVertices"], surface.asset.vertex_count),
-        "workload": workload,
-        "methods": {m: int(np.count_nonzero(skin[:, 0] == i)) for i, m in enumerate(METHODS)},
-        # The string unions of core/index.d.ts, from the Python definitions the runtime data comes from,
-        # and its interfaces of that data, rendered from the records it is built as.
-        "types": {
-            "debugMode": list(DEBUG_MODES),
-            "tierName": list(TIERS),
-            "locomotionType": list(get_args(LocomotionType)),
-            "declarations": data_declarations(),
-        },
-    }
+    plan = PackagePlan(
+        name=spec.name,
+        slug=runtime.slug,
+        version=__version__,
+        spec_sha256=spec_sha256,
+        runtime=runtime,
+        assets=assets,
+        three=THREE_RELEASE,
+        usage=_usage(motion),
+        genes="; ".join(" with ".join(g) for g in motion.genes.fields) or "nothing (no locomotion)",
+        size_range=f"{1.0 - spec.genetics.size:g} to {1.0 + spec.genetics.size:g}",
+        signatures=dict(surface.signatures),
+        tier=surface.tier,
+        subpixel=_subpixel_sentence(runtime.projected_size_max_px, surface.tier, len(tiers) > 1),
+        tier_assets=tuple(
+            TierAssets(t.data.tier, t.assets.surface_file, t.assets.surface_path, t.assets.surface_url)
+            for t in tiers
+        ),
+        gates=tuple(g.as_dict() for g in surface.gates),
+        representation=_representation(workload.field_vertices, surface.asset.vertex_count),
+        workload=workload,
+        methods={m: int(np.count_nonzero(skin[:, 0] == i)) for i, m in enumerate(METHODS)},
+        types=TypeUnions(DEBUG_MODES, tuple(TIERS), get_args(LocomotionType), data_declarations()),
+    )
     return CreaturePlan(plan, runtime, first.tapes, skeleton, first.program, tiers)
 
 
@@ -199,7 +193,7 @@ def _runtime(
     motion: MotionData,
     tiers: tuple[TierData, ...],
 ) -> CreatureData:
-    """``plan["runtime"]``: the data core/data.js holds; its tier fields are the finest shipped tier's."""
+    """``plan.runtime``: the data core/data.js holds; its tier fields are the finest shipped tier's."""
     floors = floors_for(rig.body_scale)
     first = tiers[0]
     return CreatureData(
@@ -210,7 +204,7 @@ def _runtime(
         signatures=first.signatures,
         tier=first.tier,
         surface_file=first.surface_file,
-        three_revision=THREE_RELEASE["revision"],
+        three_revision=THREE_RELEASE.revision,
         body_scale=rig.body_scale,
         slot_count=rig.slot_count,
         # One extra "part" per instance: the root rows (position + alive, yaw cos/sin + squash + size).
@@ -259,22 +253,20 @@ def _projected_size_max_px(sidecar: dict[str, object]) -> float:
     return min(sizes)
 
 
-def _usage(motion: MotionData) -> dict[str, str]:
+def _usage(motion: MotionData) -> Usage:
     """The README's minimal page (examples/minimal.js): a swimmer needs a water provider (the template
     only prints these)."""
     swims = motion.type == "swimmer"
     water = ["createAnalyticWater"] if swims else []
-    return {
-        "imports": ", ".join(["CREATURE", *water, "createCreaturePopulation"]),
-        "options": "{ capacity: 64, water: createAnalyticWater() }" if swims else "{ capacity: 64 }",
-        "water": " and `water` (required: this creature swims)" if swims else "",
-    }
+    return Usage(
+        imports=", ".join(["CREATURE", *water, "createCreaturePopulation"]),
+        options="{ capacity: 64, water: createAnalyticWater() }" if swims else "{ capacity: 64 }",
+        water=" and `water` (required: this creature swims)" if swims else "",
+    )
 
 
-def _workload(
-    rig: CompiledRig, surface: SurfaceBuild, runtime: CreatureData, tapes: list[Tape]
-) -> dict[str, Any]:
-    """``plan["workload"]``: what one body costs per frame at this tier (the README's workload table)."""
+def _workload(rig: CompiledRig, surface: SurfaceBuild, runtime: CreatureData, tapes: list[Tape]) -> Workload:
+    """``plan.workload``: what one body costs per frame at this tier (the README's workload table)."""
     asset = surface.asset
     skin = np.asarray(asset.skin)  # (V, 2): method code, trust radius
     corrected = int(np.count_nonzero(skin[:, 1] > 0))
@@ -286,17 +278,17 @@ def _workload(
     leaf_evaluations = int(
         per_program[np.where(program[in_field] == NO_PROGRAM, len(tapes) - 1, program[in_field])].sum()
     )
-    return {
-        "tier": surface.tier,
-        "slots": rig.slot_count,
-        "K": runtime.registers,
-        "programs": len(tapes),
-        "vertices": asset.vertex_count,
-        "triangles": runtime.mesh.triangles,
-        "correctedVertices": corrected,
-        "fieldVertices": int(in_field.sum()),
-        "leafEvaluationsPerBody": leaf_evaluations,
-        "poseBytesPerBody": runtime.max_parts * POSE_ROWS * 16,
+    return Workload(
+        tier=surface.tier,
+        slots=rig.slot_count,
+        K=runtime.registers,
+        programs=len(tapes),
+        vertices=asset.vertex_count,
+        triangles=runtime.mesh.triangles,
+        corrected_vertices=corrected,
+        field_vertices=int(in_field.sum()),
+        leaf_evaluations_per_body=leaf_evaluations,
+        pose_bytes_per_body=runtime.max_parts * POSE_ROWS * 16,
         # The deform pre-pass storage (tsl/deform.js DEFORM_STRIDE vec4 per vertex).
-        "deformBytesPerBody": asset.vertex_count * DEFORM_STRIDE * 16,
-    }
+        deform_bytes_per_body=asset.vertex_count * DEFORM_STRIDE * 16,
+    )

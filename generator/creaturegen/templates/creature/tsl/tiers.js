@@ -10,7 +10,7 @@ import { loadSurface, resolveSurfaceUrl } from '../core/surface.js';
 import { TIER_SURFACE_URLS } from './asset.js';
 import { layoutOf } from './body.js';
 import { DEFORM_STRIDE, vertexOrder, vertexRecords } from './deform.js';
-import { clearSlot, freeSlot, locate } from './staging.js';
+import { clearSlot, locate } from './staging.js';
 
 /**
  * The shipped tiers named by `names` (default: every tier the package ships), checked, in CREATURE.tiers
@@ -92,19 +92,26 @@ export function tierCount(tier) {
  * and draws it with the new tier. Returns false (and moves nothing) when the tier is full.
  */
 export function moveBody(state, id, tier) {
-  const { page: from, j: i } = locate(state, id);
-  if (from === null) throw new Error(`setBodyTier: instance ${id} is not alive`);
+  // No object per call (no locate() or subarray views): chooseTiers moves bodies inside the frame loop.
+  if (!Number.isInteger(id) || id < 0 || id >= state.capacity) locate(state, id);  // throws, naming the range
+  if (state.bodyPage[id] < 0) throw new Error(`setBodyTier: instance ${id} is not alive`);
+  const from = state.pages[state.bodyPage[id]];
+  const i = state.bodySlot[id];
   if (from.tier === tier) return true;
-  const slot = freeSlot(tier);
-  if (slot === null) { state.stats.tierMovesRefused += 1; return false; }
-  const { page: to, j } = slot;
+  let to = null;
+  let j = -1;
+  for (let p = 0; p < tier.pages.length && to === null; p++) {
+    const page = tier.pages[p];
+    for (let k = 0; k < page.size; k++) if (!page.alive[k]) { to = page; j = k; break; }
+  }
+  if (to === null) { state.stats.tierMovesRefused += 1; return false; }
   const { data, floatsPerInstance } = state;
   const colours = 3 * data.slotCount;
+  copyRun(from.genomes, GENOME_LENGTH * i, to.genomes, GENOME_LENGTH * j, GENOME_LENGTH);
+  copyRun(from.colours, colours * i, to.colours, colours * j, colours);
+  copyRun(from.staging, floatsPerInstance * i, to.staging, floatsPerInstance * j, floatsPerInstance);
+  copyRun(from.bounds, 6 * i, to.bounds, 6 * j, 6);
   to.motions[j] = from.motions[i];
-  to.genomes.set(from.genomes.subarray(GENOME_LENGTH * i, GENOME_LENGTH * (i + 1)), GENOME_LENGTH * j);
-  to.colours.set(from.colours.subarray(colours * i, colours * (i + 1)), colours * j);
-  to.staging.set(from.staging.subarray(floatsPerInstance * i, floatsPerInstance * (i + 1)), floatsPerInstance * j);
-  to.bounds.set(from.bounds.subarray(6 * i, 6 * i + 6), 6 * j);
   to.alive[j] = 1;
   to.paused[j] = from.paused[i];
   to.seed[j] = from.seed[i];
@@ -119,6 +126,10 @@ export function moveBody(state, id, tier) {
   state.bodySlot[id] = j;
   state.stats.tierMoves += 1;
   return true;
+}
+
+function copyRun(source, from, target, to, count) {
+  for (let k = 0; k < count; k++) target[to + k] = source[from + k];
 }
 
 /**
@@ -140,8 +151,10 @@ export function chooseTiers(state, camera, viewportHeight) {
   let moved = 0;
   // A body moved into a tier not yet visited is not asked again this call.
   const epoch = (state.chooseEpoch = (state.chooseEpoch + 1) >>> 0);
-  for (const tier of tiers) {
-    for (const page of tier.pages) {
+  for (let t = 0; t < tiers.length; t++) {
+    const pages = tiers[t].pages;
+    for (let p = 0; p < pages.length; p++) {
+      const page = pages[p];
       for (let j = 0; j < page.size; j++) {
         if (!page.alive[j]) continue;
         const id = page.ids[j];
@@ -156,8 +169,8 @@ export function chooseTiers(state, camera, viewportHeight) {
         const depth = -(v[2] * wx + v[6] * wy + v[10] * wz + v[14]);
         const size = projectedSizePx(data.bodyScale * page.motions[j].size * scale, depth, viewportHeight, camera);
         sizePx[id] = size;
-        const next = chooseTier(size, tier.name, ceilings);
-        if (next !== tier.name && moveBody(state, id, state.tierByName[next])) moved++;
+        const next = chooseTier(size, page.tier.name, ceilings);
+        if (next !== page.tier.name && moveBody(state, id, state.tierByName[next])) moved++;
       }
     }
   }
