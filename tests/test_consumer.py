@@ -43,10 +43,11 @@ from creaturegen.surface.cache import exclusive
 
 REPO = Path(__file__).resolve().parent.parent
 CONSUMER = REPO / "tests" / "consumer"
-#: slug → (spec, tier): one hero package, one in the lower tiers' skin representation (surface/skin_tier.py),
-#: so both representations meet the wheel, the tarball, tsc and the bundlers.
+#: slug → (spec, tier): one package shipping hero and distant (bodies move between them), one in the lower
+#: tiers' skin representation alone (surface/skin_tier.py), so both representations and a two-tier package
+#: meet the wheel, the tarball, tsc and the bundlers.
 CREATURES = {
-    "hopper-squash-core": ("examples/reference/hopper.json", "hero"),
+    "hopper-squash-core": ("examples/reference/hopper.json", "hero,distant"),
     "quadruped-rope-tail": ("examples/reference/quadruped.json", "distant"),
 }
 FROST = ("frost-pane-balanced", "examples/frost/frost-balanced.json")
@@ -204,6 +205,16 @@ def _masks(result: dict[str, Any]) -> dict[str, list[np.ndarray]]:
     }
 
 
+def _tier_masks(result: dict[str, Any]) -> dict[tuple[str, str], np.ndarray]:
+    """(slug, tier) → the body drawn by that coarser tier at the last tick (page.js tierMasks)."""
+    size = int(result["size"])
+    return {
+        (body["slug"], tier): np.frombuffer(base64.b64decode(m), dtype=np.uint8).reshape(size, size)
+        for body in result["bodies"]
+        for tier, m in body.get("tierMasks", {}).items()
+    }
+
+
 def _iou(a: np.ndarray, b: np.ndarray) -> float:
     return float(np.logical_and(a, b).sum() / max(np.logical_or(a, b).sum(), 1))
 
@@ -253,6 +264,11 @@ def test_unbundled_reference_renders_two_creatures_and_frost(reference: dict[str
         assert moved > 0.002, f"{slug}: the body did not move between ticks ({moved:.4f} of pixels changed)"
     a, b = (masks[s][0] for s in CREATURES)
     assert _iou(a, b) < OTHER_IOU, "two different creatures render the same silhouette"
+    # The two-tier hopper drawn by its distant tier: the same body, from its own lighter mesh.
+    tiers = _tier_masks(reference)
+    assert set(tiers) == {("hopper-squash-core", "distant")}
+    coarse = tiers[("hopper-squash-core", "distant")]
+    assert _iou(coarse, masks["hopper-squash-core"][-1]) > OTHER_IOU, "the distant tier draws another body"
     assert reference["frost"]["litPixels"] > 0.9 * reference["size"] ** 2
 
 
@@ -280,6 +296,9 @@ def test_bundled_page_matches_the_unbundled_one(
             same = _iou(got[slug][tick], want[slug][tick])
             assert same >= SAME_IOU, f"{bundler}: {slug} tick {tick} IoU {same:.3f} with its own render"
         assert _iou(got[slug][0], want[other][0]) < OTHER_IOU, f"{bundler}: {slug} renders {other}'s body"
+    for key, coarse in _tier_masks(reference).items():
+        same = _iou(_tier_masks(result)[key], coarse)
+        assert same >= SAME_IOU, f"{bundler}: {key} IoU {same:.3f} with its own unbundled render"
     assert result["frost"]["litPixels"] > 0.9 * result["size"] ** 2
 
 

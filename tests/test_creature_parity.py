@@ -344,7 +344,7 @@ def test_the_job_catches_a_spawn_that_allocates(
     spawn that creates a buffer, or compiles a pipeline (a per-body kernel, say), fails its counter gate,
     which counts the device's own calls, and only that one."""
     package = build("reference/hopper.json", out_root)
-    head = "    spawn({ seed = 0, position = [0, 0, 0] } = {}) {"
+    head = "    spawn({ seed = 0, position = [0, 0, 0], tier = home.name } = {}) {"
     planted = _planted(package, tmp_path, "population.js", [(head, f"{head}\n{_SPAWN_ALLOCATIONS[kind]}")])
     report = run_creature_parity(planted, groups=("population",))
     failed = {g["name"] for g in report.gates if g["status"] == "fail"}
@@ -363,12 +363,10 @@ def test_the_job_catches_a_spawn_that_spreads_bodies_over_pages(out_root: Path, 
         "population.js",
         [
             (
-                "      for (const page of pages) {\n        for (let j = 0; j < page.size; j++) {\n"
-                "          if (page.alive[j]) continue;\n          const genome",
-                "      const turn = population.count % pages.length;\n"
-                "      for (const page of [...pages.slice(turn), ...pages.slice(0, turn)]) {\n"
-                "        for (let j = 0; j < page.size; j++) {\n"
-                "          if (page.alive[j]) continue;\n          const genome",
+                "      const slot = freeSlot(into);\n",
+                "      const turn = population.count % into.pages.length;\n"
+                "      const turned = [...into.pages.slice(turn), ...into.pages.slice(0, turn)];\n"
+                "      const slot = freeSlot({ pages: turned });\n",
             )
         ],
     )
@@ -506,7 +504,7 @@ def test_the_job_catches_a_page_drawn_twice_in_a_pass(out_root: Path, tmp_path: 
         "  page.mesh.material = materialFor(state, page, m);\n",
         "  page.mesh.material = materialFor(state, page, m);\n"
         "  if (!page.twin) {\n"
-        "    page.twin = new THREE.Mesh(state.geometry, null);\n"
+        "    page.twin = new THREE.Mesh(page.tier.geometry, null);\n"
         "    page.twin.boundingSphere = page.mesh.boundingSphere;\n"
         "    group.add(page.twin);\n"
         "  }\n"

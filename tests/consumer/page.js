@@ -68,7 +68,18 @@ async function creatureMasks(renderer, pkg, target) {
     renderer.setRenderTarget(null);
     masks.push(toBase64(mask(await readTarget(renderer, target))));
   }
-  const result = { slug: pkg.CREATURE.slug, vertices: pkg.CREATURE.mesh.vertices, masks };
+  // A package shipping several tiers: the same body moved into each coarser tier (its own .glb, which the
+  // bundle must have fetched) and drawn again at the last tick.
+  const tierMasks = {};
+  for (const tier of population.tiers.slice(1)) {
+    population.setBodyTier(0, tier.name);
+    population.flush();
+    renderer.setRenderTarget(target);
+    renderer.render(scene, camera);
+    renderer.setRenderTarget(null);
+    tierMasks[tier.name] = toBase64(mask(await readTarget(renderer, target)));
+  }
+  const result = { slug: pkg.CREATURE.slug, vertices: pkg.CREATURE.mesh.vertices, masks, tierMasks };
   population.dispose();
   return result;
 }

@@ -26,6 +26,8 @@ export async function typed(renderer: THREE.WebGPURenderer, scene: THREE.Scene, 
   const steps: number = hoppers.update(1 / 60);
   const drawn: number = hoppers.stats.lastFrameDrawnBodies + hoppers.stats.lastFrameCulledBodies;
   hoppers.cullWith();
+  const moved: number = hoppers.chooseTiers(camera, 720) + hoppers.tiers.length;
+  const kept: boolean = hoppers.setBodyTier(id, hoppers.tiers[hoppers.tiers.length - 1].name);
   hoppers.setDebugMode(DEBUG_MODES[0]);
   const diagnostics = createDiagnostics(renderer, hoppers);
   const pose: Float32Array = await diagnostics.readPose(id);
@@ -35,5 +37,5 @@ export async function typed(renderer: THREE.WebGPURenderer, scene: THREE.Scene, 
   const frost = await createFrostEffect(renderer, scene, camera);
   frost.update(0, 1 / 60);
   frost.render();
-  return steps + drawn + pose.length + staged.length + slug.length + (motion ? 1 : 0);
+  return steps + drawn + moved + (kept ? 1 : 0) + pose.length + staged.length + slug.length + (motion ? 1 : 0);
 }
