@@ -39,7 +39,7 @@ from .report import ParityReport
 #: only the order of a few operations differs).
 SIZE_REL_TOL = 1e-9
 #: Frames and bodies of the walk, and its nearest and farthest camera, × L.
-WALK_FRAMES, WALK_BODIES, WALK_NEAR, WALK_FAR = 48, 6, 1.5, 24.0
+WALK_FRAMES, WALK_BODIES, WALK_NEAR, WALK_FAR = 24, 6, 1.5, 24.0
 #: The mask target's side in pixels (the body several times its coarser tier's ceiling size across).
 MASK_SIZE = 256
 
