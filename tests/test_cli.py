@@ -55,12 +55,15 @@ def test_one_bad_file_among_good_ones_fails_therun_cli() -> None:
 
 
 def test_build_prints_the_compiled_summary(tmp_path: Path) -> None:
-    done = run_cli("build", str(EXAMPLES / "lizard.json"), "-o", str(tmp_path / "out"))
+    # The moth: an explicit blend tree with two roots, and a surface test_surface_build extracts anyway (the
+    # run's shared cache), so this reads the summary rather than paying for another surface and picture.
+    done = run_cli("build", str(EXAMPLES / "moth.json"), "-o", str(tmp_path / "out"), "--picture", "off")
     assert done.returncode == 0, done.stderr
     lines = done.stdout.splitlines()
-    assert "creature 'Lizard Explicit Tree' -> package lizard-explicit-tree" in lines
-    assert "  slots 17 of maxParts 64" in lines
-    assert "  blend tree, 7 nodes, 1 root(s)" in lines
+    assert "creature 'Moth Two Roots' -> package moth-two-roots" in lines
+    assert "  parts 1 capsule, 2 cone, 1 rope, 1 sphere (5 in all)" in lines
+    assert "  slots 7 of maxParts 64" in lines
+    assert "  blend tree, 3 nodes, 2 root(s)" in lines
 
 
 def test_schema_check_detects_staleness(tmp_path: Path) -> None:
