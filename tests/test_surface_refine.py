@@ -18,6 +18,7 @@ from creaturegen.surface.lattice import (
     EXTRA_REFINEMENTS,
     MAX_REFINEMENTS,
     SMALL_LATTICE_NODES,
+    FixedBackend,
     ValidatedMesh,
     _may_refine,
     validated_mesh,
@@ -140,7 +141,7 @@ def _validated(path: Path, tier: str, said: list[str]) -> ValidatedMesh:
     assert isinstance(spec, CharacterSpec)
     rig = compile_rig(spec)
     backend = NumpyBackend(rig.graph, rig.slots)
-    return validated_mesh(rig, build_skeleton(spec, rig), tier, backend, "test", said.append)
+    return validated_mesh(rig, build_skeleton(spec, rig), tier, FixedBackend(backend, "test"), said.append)
 
 
 def test_a_lattice_refined_for_its_genus_changes_no_result(monkeypatch: pytest.MonkeyPatch) -> None:

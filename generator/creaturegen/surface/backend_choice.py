@@ -1,17 +1,14 @@
-"""Which sampling backend samples the lattice: the one asked for, or the faster measured on this machine.
+"""Which sampling backend samples each lattice: the one asked for, or the faster measured on this machine.
 
 numpy is always there; wgpu (Mesa lavapipe or a real GPU) is faster per point on big lattices but pays a
-start-up of seconds, so "auto" times both on the same points, or does not start wgpu at all when numpy
-would finish first.
+start-up of seconds, so "auto" does not start wgpu while numpy would finish the lattice first, and times
+both on the same points once it has.
 """
 
 from __future__ import annotations
 
-import math
-
 import numpy as np
 
-from ..candidates import DEFAULT_TIER
 from ..model import layout as col
 from ..rig import CompiledRig
 from .backends import (
@@ -20,62 +17,89 @@ from .backends import (
     BackendUnavailableError,
     FieldBackend,
     NumpyBackend,
+    Points,
     make_backend,
     time_backend,
 )
-from .grid import GridTooFineError, make_grid
 from .progress import Progress
 
 #: Calibration points for picking the faster sampling backend.
 CALIBRATION_POINTS = 32768
 #: wgpu's start-up before its first sample (adapter, device, wgpu-native's cffi type parsing, the first
-#: pipeline): 3.1 s to 4.2 s measured in a cProfile'd build on the 2-core machine under load, so 2 s is
-#: a floor. Against numpy's 0.3 µs per point that is several million samples.
-WGPU_STARTUP_S = 2.0
-#: Nodes a build may sample per node of its first lattice: the narrow band holds 15-35 % of a dense
-#: lattice (the sampling report's "% of a dense pass"), and the refinement budget allows two √2 finer
-#: lattices (2^1.5 and 2^3 times the nodes): 0.35 · (1 + 2.83 + 8) ≈ 4.1.
-SAMPLED_NODES_PER_FIRST_NODE = 4.1
+#: pipeline): 3.1 s to 4.2 s measured in a cProfile'd build on the 2-core machine under load (stop 28),
+#: 6.4 s (4.6 s of it the device) on a 2-core Xeon (stop 45). Against numpy's ~0.8 µs per point that is
+#: millions of samples.
+WGPU_STARTUP_S = 4.0
+#: The share of a lattice the narrow band samples at most: 15-35 % of a dense pass (the sampling report's
+#: "% of a dense pass"; the beetle's first lattice 17.7 %).
+BAND_SHARE = 0.35
 
 
-def choose_backend(
-    rig: CompiledRig, requested: str, progress: Progress, tier: str = DEFAULT_TIER
-) -> tuple[FieldBackend, str]:
-    """The requested backend, or for "auto" the faster of numpy and wgpu measured on this machine.
+class SamplingBackends:
+    """The backend each lattice of one build samples with: the one asked for, or for "auto" the faster for
+    that lattice with wgpu's start-up counted until it has been paid.
 
-    Faster for the whole build, start-up included: wgpu pays WGPU_STARTUP_S before its first sample, so
-    when numpy is predicted to finish every lattice the build may sample in less than that, wgpu is not
-    started at all. Otherwise both are timed on the same points and the faster per point is chosen."""
-    if requested != "auto":
-        if requested not in BACKENDS:
+    A build samples its first lattice and, only when a mesh gate fails, √2-finer ones (2.8 and 8 times
+    the nodes). Deciding once for every lattice the build might sample started wgpu for bodies that never
+    refine: the beetle's hero build then paid 6.4 s of start-up to save 0.2 s of sampling (measured, stop
+    45: 31.6 s with wgpu against 27.7 s with numpy, the same .glb). Each lattice now predicts numpy's time
+    for its own band; wgpu starts when that exceeds the start-up, and once started it samples every later
+    lattice it is faster on. The backends agree to the byte (tests/test_surface_build.py), so the choice
+    moves only time."""
+
+    def __init__(self, rig: CompiledRig, requested: str, progress: Progress) -> None:
+        if requested != "auto" and requested not in BACKENDS:
             raise BackendChoiceError(f"--backend: unknown {requested!r}; choose auto, {', '.join(BACKENDS)}")
-        return make_backend(requested, rig.graph, rig.slots), "requested"
-    numpy_backend = NumpyBackend(rig.graph, rig.slots)
-    rng = np.random.default_rng(0)
-    lo = np.min(np.minimum(rig.slots[:, col.A], rig.slots[:, col.B]), axis=0)
-    hi = np.max(np.maximum(rig.slots[:, col.A], rig.slots[:, col.B]), axis=0)
-    points = rng.uniform(lo, hi, (CALIBRATION_POINTS, 3)).astype(np.float32)
-    t_numpy = time_backend(numpy_backend, points, repeats=2)
-    try:
-        nodes = float(np.prod(make_grid(rig.slots, rig.graph, tier, rig.slot_parts, 0).shape))
-    except GridTooFineError:
-        nodes = math.inf
-    predicted = t_numpy / CALIBRATION_POINTS * nodes * SAMPLED_NODES_PER_FIRST_NODE
-    if predicted < WGPU_STARTUP_S:
-        why = (
-            f"numpy predicted {predicted:.2f} s for every lattice the build may sample, under wgpu's "
-            f"{WGPU_STARTUP_S:g} s start-up ({CALIBRATION_POINTS}-point calibration: numpy "
-            f"{t_numpy * 1e3:.1f} ms)"
-        )
-        progress(f"sampling backend numpy ({why})")
-        return numpy_backend, why
-    try:
-        gpu = make_backend("wgpu", rig.graph, rig.slots)
-        t_gpu = time_backend(gpu, points, repeats=2)
-    except BackendUnavailableError as exc:
-        progress(f"sampling backend numpy (wgpu unavailable: {exc})")
-        return numpy_backend, f"wgpu unavailable: {exc}"
-    chosen: FieldBackend = gpu if t_gpu < t_numpy else numpy_backend
-    why = f"{CALIBRATION_POINTS}-point calibration: numpy {t_numpy * 1e3:.1f} ms, wgpu {t_gpu * 1e3:.1f} ms"
-    progress(f"sampling backend {chosen.name} ({why})")
-    return chosen, why
+        self._rig = rig
+        self._requested = requested
+        self._progress = progress
+        self._numpy = NumpyBackend(rig.graph, rig.slots)
+        self._points: Points | None = None
+        self._t_numpy: float | None = None
+        self._gpu: FieldBackend | None = None
+        self._t_gpu: float | None = None
+        self._gpu_refused: str | None = None
+
+    def for_lattice(self, nodes: int) -> tuple[FieldBackend, str]:
+        """The backend for a lattice of ``nodes`` nodes, and why."""
+        if self._requested != "auto":
+            if self._gpu is None:
+                self._gpu = make_backend(self._requested, self._rig.graph, self._rig.slots)
+            return self._gpu, "requested"
+        points = self._calibration_points()
+        if self._t_numpy is None:
+            self._t_numpy = time_backend(self._numpy, points, repeats=2)
+        t_numpy = self._t_numpy
+        calibration = f"{CALIBRATION_POINTS}-point calibration: numpy {t_numpy * 1e3:.1f} ms"
+        if self._gpu_refused is not None:
+            return self._chosen(self._numpy, f"wgpu unavailable: {self._gpu_refused}")
+        if self._gpu is None:
+            predicted = t_numpy / CALIBRATION_POINTS * nodes * BAND_SHARE
+            if predicted < WGPU_STARTUP_S:
+                why = (
+                    f"numpy predicted {predicted:.2f} s for this lattice's band ({nodes:,} nodes), under "
+                    f"wgpu's {WGPU_STARTUP_S:g} s start-up ({calibration})"
+                )
+                return self._chosen(self._numpy, why)
+            try:
+                self._gpu = make_backend("wgpu", self._rig.graph, self._rig.slots)
+                self._t_gpu = time_backend(self._gpu, points, repeats=2)
+            except BackendUnavailableError as exc:
+                self._gpu_refused = str(exc)
+                return self._chosen(self._numpy, f"wgpu unavailable: {exc}")
+        assert self._t_gpu is not None
+        why = f"{calibration}, wgpu {self._t_gpu * 1e3:.1f} ms"
+        return self._chosen(self._gpu if self._t_gpu < t_numpy else self._numpy, why)
+
+    def _calibration_points(self) -> Points:
+        if self._points is None:
+            slots = self._rig.slots
+            lo = np.min(np.minimum(slots[:, col.A], slots[:, col.B]), axis=0)
+            hi = np.max(np.maximum(slots[:, col.A], slots[:, col.B]), axis=0)
+            rng = np.random.default_rng(0)
+            self._points = rng.uniform(lo, hi, (CALIBRATION_POINTS, 3)).astype(np.float32)
+        return self._points
+
+    def _chosen(self, backend: FieldBackend, why: str) -> tuple[FieldBackend, str]:
+        self._progress(f"sampling backend {backend.name} ({why})")
+        return backend, why

@@ -31,7 +31,7 @@ from ..rig import CompiledRig
 from ..rig.signatures import signatures as rig_signatures
 from . import identity
 from .asset import SurfaceAsset
-from .backend_choice import choose_backend
+from .backend_choice import SamplingBackends
 from .cache import CachedSurface, SurfaceCache
 from .components import ComponentPolicy
 from .correction_region import (
@@ -202,8 +202,7 @@ def _mesh_stage(
     pending: PendingEnvelope,
 ) -> tuple[ValidatedMesh, PoseEnvelope]:
     """The validated rest mesh, then the motion envelope (which stepped meanwhile)."""
-    chosen, why = choose_backend(rig, backend, progress, tier)
-    validated = validated_mesh(rig, skeleton, tier, chosen, why, progress)
+    validated = validated_mesh(rig, skeleton, tier, SamplingBackends(rig, backend, progress), progress)
     t = time.perf_counter()
     envelope = pending.result()
     validated.timings["envelope"] = time.perf_counter() - t

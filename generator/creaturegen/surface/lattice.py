@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import time
 from dataclasses import dataclass, replace
+from typing import Protocol
 
 import numpy as np
 import numpy.typing as npt
@@ -40,6 +41,24 @@ MAX_REFINEMENTS = 2
 #: pass at 3.1 M and 3.8 M nodes, 20 s and 30 s cold. A passing build never reaches these refinements.
 EXTRA_REFINEMENTS = 3
 SMALL_LATTICE_NODES = 8_000_000
+
+
+class LatticeBackend(Protocol):
+    """Picks the sampling backend per lattice (backend_choice.SamplingBackends): a refined lattice may
+    warrant a backend the first did not."""
+
+    def for_lattice(self, nodes: int) -> tuple[FieldBackend, str]: ...
+
+
+@dataclass(frozen=True)
+class FixedBackend:
+    """One backend for every lattice, for a caller that has chosen already."""
+
+    backend: FieldBackend
+    why: str
+
+    def for_lattice(self, nodes: int) -> tuple[FieldBackend, str]:
+        return self.backend, self.why
 
 
 @dataclass(frozen=True)
@@ -92,7 +111,7 @@ def _fails_euler(attempt: ValidatedMesh) -> bool:
 
 
 def validated_mesh(
-    rig: CompiledRig, skeleton: Skeleton, tier: str, chosen: FieldBackend, why: str, progress: Progress
+    rig: CompiledRig, skeleton: Skeleton, tier: str, backends: LatticeBackend, progress: Progress
 ) -> ValidatedMesh:
     """Sample, extract and gate; retry √2 finer while a mesh gate fails and the refinement budget lasts
     (``_may_refine``). The result is the first lattice that passes or, when none does, the one that
@@ -105,7 +124,7 @@ def validated_mesh(
     refinement = 0
     while True:
         try:
-            attempt = _one_lattice(rig, skeleton, tier, chosen, why, progress, refinement)
+            attempt = _one_lattice(rig, skeleton, tier, backends, progress, refinement)
         except GridTooFineError as exc:
             if not attempts:
                 raise
@@ -150,8 +169,7 @@ def _one_lattice(
     rig: CompiledRig,
     skeleton: Skeleton,
     tier: str,
-    chosen: FieldBackend,
-    why: str,
+    backends: LatticeBackend,
     progress: Progress,
     refinement: int,
 ) -> ValidatedMesh:
@@ -159,6 +177,7 @@ def _one_lattice(
     timings: dict[str, float] = {"sampling": 0.0, "extraction": 0.0, "validation": 0.0}
     rest_field = BodyField(rig.graph, rig.slots)
     grid = make_grid(rig.slots, rig.graph, tier, rig.slot_parts, refinement)
+    chosen, why = backends.for_lattice(int(np.prod(grid.shape)))
     if grid.limited_by:
         progress(
             f"{grid.limited_by} is too thin for the {tier} sagitta target within "

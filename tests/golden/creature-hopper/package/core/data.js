@@ -118,7 +118,7 @@ export const CREATURE = Object.freeze({
   "registers": 13,
   "roundCone": [0, 0, 0, 0, 0, 0, 0],
   "signatures": {
-    "compilerSignature": "7f6f8fe10b4a63e84bed7b2ac4f02803fd81a39763fcefd3af42892653ab89e9",
+    "compilerSignature": "b70df71f91ec4625af18119ac1e926f4b22070d3d2c25e019da739a7b89eaebf",
     "geometryDigest": "400b0d18a2a9f6bbbfe5b441f89767f552a4f3b4c45a368d1129d632e1d2f4f1",
     "topologySignature": "330d551e8c006f84b01459c84db69ca8c43aec5bc9d9083d3e85c291be5a68bf"
   },
@@ -186,7 +186,7 @@ export const CREATURE = Object.freeze({
       "projectedSizeMaxPx": 186.69647541568403,
       "registers": 13,
       "signatures": {
-        "compilerSignature": "7f6f8fe10b4a63e84bed7b2ac4f02803fd81a39763fcefd3af42892653ab89e9",
+        "compilerSignature": "b70df71f91ec4625af18119ac1e926f4b22070d3d2c25e019da739a7b89eaebf",
         "geometryDigest": "400b0d18a2a9f6bbbfe5b441f89767f552a4f3b4c45a368d1129d632e1d2f4f1",
         "topologySignature": "330d551e8c006f84b01459c84db69ca8c43aec5bc9d9083d3e85c291be5a68bf"
       },
