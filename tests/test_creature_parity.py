@@ -66,6 +66,7 @@ def assert_every_gate(package: Path, name: str) -> None:
         f"pose pages in use after {SPAWNS} spawns of pageSize {PAGE_SIZE}",
         "pose rows (slots and root): GPU vs the Python locomotion reference",
         "planted feet in the GPU pose buffer vs their plant points",
+        "debug shell on the pose rows: GPU vs numpy",
     ):
         assert expected in names
     assert written["measurements"]["field"]["points"] >= 4096
@@ -591,3 +592,27 @@ def test_debug_views_draw_their_own_pictures_and_a_dead_switch_fails(out_root: P
     assert any(name.startswith("debug views identical to the shipped view") for name in failed), (
         report.summary()
     )
+
+
+@pytest.mark.browser
+@pytest.mark.parametrize(
+    ("swap", "gate"),
+    [
+        (
+            ("p.sub(r.yzw.mul(r.x.div(gg)))", "p.sub(r.yzw.mul(r.x.div(gg)).mul(0.5))"),
+            "debug shell after 2 snap steps: GPU vs numpy (off seams)",
+        ),
+        (
+            ("SHELL_CAP_RINGS = Object.freeze([3, 2, 2])", "SHELL_CAP_RINGS = Object.freeze([4, 2, 2])"),
+            "debug shell vertices per slot vs (2 + 2·3)·12 + 2 (hero)",
+        ),
+    ],
+    ids=["half-newton-steps", "hero-cap-rings"],
+)
+def test_the_job_catches_a_wrong_debug_shell(
+    swap: tuple[str, str], gate: str, out_root: Path, tmp_path: Path
+) -> None:
+    """The 'shell' view snapping by half steps, or drawn with the wrong ring count for its tier."""
+    package = build("reference/hopper.json", out_root)
+    failed, summary = _failures(package, tmp_path, "shell.js", [swap], ("shell",))
+    assert gate in failed, summary

@@ -18,6 +18,7 @@ from creaturegen.creature.lod import HYSTERESIS, TIER_ORDER
 from creaturegen.creature.plan import DEBUG_MODES, DEFORM_STRIDE
 from creaturegen.creature.pose import POSE_ROWS
 from creaturegen.creature.runtime import CreatureData
+from creaturegen.lab.creature_shell import SHELL_CAP_RINGS, SHELL_RADIAL, SHELL_SNAP_STEPS, SHELL_TIERS
 from creaturegen.model.lcg import LCG_A, LCG_C
 from creaturegen.model.record import json_name
 from creaturegen.resources import templates_dir
@@ -34,6 +35,10 @@ PINNED: tuple[tuple[str, str, object], ...] = (
     ("tsl/material.js", "DEBUG_MODES", list(DEBUG_MODES)),
     ("core/lod.js", "TIER_ORDER", list(TIER_ORDER)),
     ("core/lod.js", "TIER_HYSTERESIS", HYSTERESIS),
+    ("tsl/shell.js", "SHELL_TIERS", list(SHELL_TIERS)),
+    ("tsl/shell.js", "SHELL_RADIAL", list(SHELL_RADIAL)),
+    ("tsl/shell.js", "SHELL_CAP_RINGS", list(SHELL_CAP_RINGS)),
+    ("tsl/shell.js", "SHELL_SNAP_STEPS", list(SHELL_SNAP_STEPS)),
 )
 
 #: CreatureData fields that were these constants: none may come back.

@@ -78,10 +78,17 @@ def posed_table(ref: PackageReference, pose: Pose, size: float = 1.0) -> F64:
     return posed_slots(sized_slots(ref.rig.slots, size), pose)
 
 
-def field_at(ref: PackageReference, table: F64, points: F64, size: float = 1.0) -> FieldSample:
-    """The field of a posed slot table (of an individual of ``size``: its colour-kernel floor scales too)."""
+def field_at(
+    ref: PackageReference,
+    table: F64,
+    points: F64,
+    size: float = 1.0,
+    dtype: type[np.floating] = np.float64,
+) -> FieldSample:
+    """The field of a posed slot table (of an individual of ``size``: its colour-kernel floor scales too),
+    evaluated in ``dtype`` (float32: the GPU's precision, to tell ill-conditioned points)."""
     graph = sized_graph(ref.rig.graph, size)
-    return sample_graph(graph, table, points, floors_for(ref.rig.body_scale).k_floor * size)
+    return sample_graph(graph, table, points, floors_for(ref.rig.body_scale).k_floor * size, dtype=dtype)
 
 
 def probe_points(table: F64, graph_pairs: list[tuple[int, int]], count: int, seed: int = 0) -> F64:

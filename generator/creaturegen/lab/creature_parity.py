@@ -14,6 +14,9 @@ Gates, all measured in the run (thresholds are relative to the body scale L wher
   field gates over the other vertices only;
 - correction: every vertex the GPU corrected is no farther from the numpy posed field than its skinned
   position, and the corrected residual is reported;
+- debug shell (the 'shell' view): vertices per slot vs the seed's (2 + 2·capRings)·radial + 2 for the tier,
+  every slot's shell placed on its pose row and snapped onto the union field, GPU vs numpy
+  (creature_shell.py);
 - shadows: the silhouette seen from the sun vs the shadow footprint on the ground (the depth pass uses the
   same position function), max distance of a disagreeing texel to the other mask's edge;
 - no GPU validation errors; no pipelines and no buffers created by a burst of spawns that fills the lab's
@@ -30,8 +33,8 @@ Gates, all measured in the run (thresholds are relative to the body scale L wher
 
 This module runs the groups against one lab session and writes the report; the session is
 creature_lab.py, the gates creature_pose.py (pose pages, field, motion, stateHash), creature_skin.py
-(skinning, correction, display path), creature_population.py (spawn burst, genetics grid) and
-creature_views.py (shadows, pictures).
+(skinning, correction, display path), creature_shell.py (debug shell), creature_population.py (spawn
+burst, genetics grid) and creature_views.py (shadows, pictures).
 """
 
 from __future__ import annotations
@@ -54,12 +57,13 @@ from .creature_population import (
     moves_every_tick,
 )
 from .creature_pose import hash_gate, motion_gates, pose_and_field_gates
+from .creature_shell import shell_gates
 from .creature_skin import skin_gates
 from .creature_tiers import shipped_ceilings, tier_gates
 from .creature_views import pictures, shadow_gate
 from .report import ParityReport, adapter_gate, console_problems
 
-GATE_GROUPS = ("population", "hash", "field", "motion", "skin", "shadow", "cull", "tiers", "grid")
+GATE_GROUPS = ("population", "hash", "field", "motion", "skin", "shell", "shadow", "cull", "tiers", "grid")
 
 
 def run_creature_parity(
@@ -99,6 +103,8 @@ def run_creature_parity(
         phase("field", lambda: pose_and_field_gates(page, ref, motion, report))
         phase("motion", lambda: motion_gates(page, ref, motion, report))
         phase("skin", lambda: skin_gates(page, ref, motion, report))
+        finest = json.loads((package / "build-report.json").read_text())["tier"]
+        phase("shell", lambda: shell_gates(page, ref, motion, finest, report))
         # A package shipping several tiers: bodies moved between them by their size on screen. Before the
         # shadow gate, whose edits of the page materials make every page rebuild its bindings when next
         # drawn (the lab's doing, which the walk's device count would charge to the tier moves); it puts

@@ -475,6 +475,19 @@ async function main() {
       return Array.from(r);
     },
     async readPose(i = 0) { return Array.from(await diag.readPose(i)); },
+    /**
+     * Body i's debug shell through the package's shellVertex (creature-local), and the vertex count of the
+     * shell mesh the 'shell' view draws (the view is built, not drawn, and the mode put back).
+     */
+    async readShell(i = 0) {
+      const r = await diag.readShell(i);
+      const mode = pop.debugMode;
+      pop.setDebugMode('shell');
+      let drawnVertices = -1;
+      scene.traverse((o) => { if (o.isMesh && o.name.endsWith('.shell')) drawnVertices = o.geometry.attributes.position.count; });
+      pop.setDebugMode(mode);
+      return { counts: r.counts, placed: Array.from(r.placed), position: Array.from(r.position), distance: Array.from(r.distance), drawnVertices };
+    },
     /** The locomotion gates of body i (worst values since its reset, measured by the JS core every tick). */
     motionGates(i = 0) { return pop.motion(i).gates; },
     /** Body i's locomotion state as the JS core in this page holds it (root, slots, ropes) and its tick. */

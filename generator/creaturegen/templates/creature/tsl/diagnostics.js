@@ -7,6 +7,7 @@ import { Fn, instanceIndex, instancedArray, int, uniform, vec4 } from 'three/tsl
 import { bodyFunctions, bodyVertex } from './body.js';
 import { DEFORM_STRIDE, recordInputs } from './deform.js';
 import { populationInternals } from './internals.js';
+import { shellCounts, shellGeometry, shellVertex } from './shell.js';
 
 export { populationInternals };
 
@@ -66,7 +67,59 @@ export function createDiagnostics(renderer, population, { maxPoints = 8192 } = {
     return probeState;
   }
 
+  let shellState = null;
+  function shellKernels() {
+    if (shellState) return shellState;
+    const counts = shellCounts(internals.tiers[0].data.tier);
+    const unit = shellGeometry(counts);
+    const m = counts.vertices * layout.slotCount;
+    const dirs = new Float32Array(4 * m);
+    for (let i = 0; i < m; i++) {
+      const v = i % counts.vertices;
+      for (let c = 0; c < 3; c++) dirs[4 * i + c] = unit.attributes.position.array[3 * v + c];
+      dirs[4 * i + 3] = unit.attributes.cgEnd.array[v];
+    }
+    unit.dispose();
+    const input = instancedArray(dirs, 'vec4').toReadOnly();
+    const out = instancedArray(2 * m, 'vec4');
+    const instance = uniform(0, 'int');
+    const kernels = pages.map((page) => {
+      const fns = bodyFunctions(layout, page.pose, programs);
+      return Fn(() => {
+        const i = int(instanceIndex);
+        const slot = i.div(counts.vertices);
+        const d = input.element(i).toVar();
+        const base = instance.mul(rowsPerInstance).toVar();
+        const shell = shellVertex(layout, fns, page.pose, { base, slot, dir: d.xyz, end: d.w, steps: counts.steps });
+        out.element(i.mul(2)).assign(vec4(shell.placed, 0));
+        out.element(i.mul(2).add(1)).assign(vec4(shell.position, shell.value.x));
+      })().compute(m);
+    });
+    shellState = { out, instance, kernels, counts, m };
+    return shellState;
+  }
+
   return {
+    /**
+     * The debug shell of instance `id` as shell.js draws it (creature-local, before the root transform), slot
+     * after slot: { counts, placed (on the pose rows), position (snapped), distance (d there) }.
+     */
+    async readShell(id) {
+      const { page, index } = where(id);
+      const s = shellKernels();
+      s.instance.value = index;
+      renderer.compute(s.kernels[pages.indexOf(page)]);
+      const raw = new Float32Array(await renderer.getArrayBufferAsync(s.out.value));
+      const placed = new Float32Array(3 * s.m), position = new Float32Array(3 * s.m), distance = new Float32Array(s.m);
+      for (let i = 0; i < s.m; i++) {
+        for (let c = 0; c < 3; c++) {
+          placed[3 * i + c] = raw[8 * i + c];
+          position[3 * i + c] = raw[8 * i + 4 + c];
+        }
+        distance[i] = raw[8 * i + 7];
+      }
+      return { counts: s.counts, placed, position, distance };
+    },
     /** Pose rows of instance `id` from the CPU staging copy (what the next upload sends). */
     stagedPose: internals.stagedPose,
     /** The debug-mode variants built so far ('off' is the shipped one). */

@@ -95,7 +95,19 @@ export function createBodyMaterial(layout: Layout, pose: PoseStorage, deform: Po
 export function rootRotate(root1: Node, v: Node): Node;
 export function rootPoint(root1: Node, p: Node): Node;
 export function rootNormal(root1: Node, n: Node): Node;
-export function createShellMesh(layout: Layout, pose: PoseStorage, drawList: PoseStorage, name: string): Mesh;
+/** The debug shell's counts per tier (hero, repeated, distant): segments around, rings per cap, snap steps. */
+export const SHELL_TIERS: readonly TierName[];
+export const SHELL_RADIAL: readonly number[];
+export const SHELL_CAP_RINGS: readonly number[];
+export const SHELL_SNAP_STEPS: readonly number[];
+/** A tier's shell counts; vertices = (2 + 2·capRings)·radial + 2 per slot. */
+export interface ShellCounts { radial: number; capRings: number; steps: number; vertices: number }
+export function shellCounts(tier: TierName): ShellCounts;
+/** The unit shell of one slot: `position` the direction from its end's centre, `cgEnd` the end (0 or 1). */
+export function shellGeometry(counts: ShellCounts): BufferGeometry;
+/** One shell vertex placed on its slot's pose row and snapped onto the field (inline, in a Fn). */
+export function shellVertex(layout: Layout, fns: BodyFunctions, pose: PoseStorage, inputs: { base: Node; slot: Node; dir: Node; end: Node; steps: number }): { placed: Node; position: Node; value: Node };
+export function createShellMesh(layout: Layout, fns: BodyFunctions, pose: PoseStorage, drawList: PoseStorage, name: string, tier: TierName): Mesh;
 
 /** Throws unless `renderer` is an initialised WebGPURenderer on the WebGPU backend. */
 export function assertWebGPU(renderer: WebGPURenderer): void;

@@ -8,7 +8,9 @@ export {
   PATHS, vertexOrder, vertexRecords,
 } from './deform.js';
 export { DEBUG_MODES, checkDebugMode, createBodyMaterial, rootNormal, rootPoint, rootRotate } from './material.js';
-export { createShellMesh } from './shell.js';
+export {
+  SHELL_CAP_RINGS, SHELL_RADIAL, SHELL_SNAP_STEPS, SHELL_TIERS, createShellMesh, shellCounts, shellGeometry, shellVertex,
+} from './shell.js';
 export {
   assertThreeRevision, assertWebGPU, createCreaturePopulation, programStorage, surfaceGeometry,
 } from './population.js';

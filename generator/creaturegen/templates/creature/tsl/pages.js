@@ -79,14 +79,15 @@ function kernelFor(state, page, kind) {
   return page.kernels.get(kind);
 }
 
-/** Show debug mode `m` on `page`: its material, its pre-pass kernel, and the capsule shell for 'shell'. */
+/** Show debug mode `m` on `page`: its material, its pre-pass kernel, and the snapped shell for 'shell'. */
 export function showMode(state, page, m) {
   const { data, group } = state;
   const { layout } = page.tier;
   page.mesh.material = materialFor(state, page, m);
   page.kernel = kernelFor(state, page, kernelKind(m));
   if (m === 'shell' && !page.shell) {
-    page.shell = createShellMesh(layout, page.pose, page.drawList, page.mesh.name);
+    const fns = bodyFunctions(layout, page.pose, page.tier.programs);
+    page.shell = createShellMesh(layout, fns, page.pose, page.drawList, page.mesh.name, page.tier.data.tier);
     page.shell.boundingSphere = page.mesh.boundingSphere;
     group.add(page.shell);
   }
