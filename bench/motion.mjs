@@ -8,10 +8,12 @@
 // unoptimised code, which boxes every double (14 collections in one make test run; 46 per window with
 // --concurrent-recompilation-delay=1000). The steady-state code is the same; only when it arrives is fixed.
 //
-// Prints one JSON object: per-step cost (µs per creature per fixed step, median of rounds), steady-state
-// allocation (V8 heap growth and garbage collections over a run of steps, after a full collection), and,
+// Prints one JSON object: per-step cost (µs per creature per fixed step, median of rounds, and the p50 / p95
+// / max of single steps of the whole population), steady-state allocation (V8 heap growth and garbage
+// collections over a run of steps, after a full collection), the bodies' peak live heap, and,
 // for creatures with ropes, the rope cost against substeps × passes × segments. Bench code: it may use
 // wall clocks; the shipped core it measures may not.
+import { performance } from 'node:perf_hooks';
 import { pathToFileURL } from 'node:url';
 import { allocationWindows } from './alloc.mjs';
 
@@ -47,7 +49,41 @@ function stepCost(motionData, count = options.bodies) {
     samples.push(Number(process.hrtime.bigint() - t0) / 1000 / (options.ticks * list.length));
   }
   samples.sort((a, b) => a - b);
-  return { median: samples[Math.floor(samples.length / 2)], min: samples[0], max: samples.at(-1), samples };
+  // Single fixed steps of the whole population, each timed alone: a step that spikes (a gait event, a
+  // rope settling, a collection) shows in the p95 and the max, which round means smooth away.
+  const steps = new Float64Array(options.rounds * options.ticks);
+  for (let k = 0; k < steps.length; k++) {
+    const t0 = performance.now();
+    for (let i = 0; i < list.length; i++) list[i].step();
+    steps[k] = ((performance.now() - t0) * 1000) / list.length;
+  }
+  steps.sort();
+  const at = (q) => steps[Math.min(steps.length - 1, Math.floor(q * steps.length))];
+  const perStep = { steps: steps.length, p50: at(0.5), p95: at(0.95), max: steps[steps.length - 1] };
+  return { median: samples[Math.floor(samples.length / 2)], min: samples[0], max: samples.at(-1), samples, perStep };
+}
+
+/**
+ * The live heap of `count` bodies: V8 heapUsed after a full collection at checkpoints over `allocSteps`
+ * steps of all of them (garbage does not count), less the heap once they are released and collected (so
+ * the code and type feedback their steps compiled, which stay, do not count either); the peak over the
+ * checkpoints, and per body.
+ */
+function liveBytes(motionData, count = options.bodies) {
+  let list = bodies(motionData, count);
+  const heaps = [];
+  const parts = 5;
+  for (let c = 0; c <= parts; c++) {
+    if (c > 0) for (let k = 0; k < options.allocSteps / parts; k++) for (let i = 0; i < list.length; i++) list[i].step();
+    globalThis.gc();
+    heaps.push(process.memoryUsage().heapUsed);
+  }
+  list = null;
+  globalThis.gc();
+  const released = process.memoryUsage().heapUsed;
+  const checkpoints = heaps.map((h) => h - released);
+  const peak = Math.max(...checkpoints);
+  return { bodies: count, peakLiveBytes: peak, perBodyBytes: peak / count, checkpoints };
 }
 
 /** `steps` steps of `m`: the measured loop, a function of its own so it is optimised (and its compiled
@@ -69,6 +105,7 @@ const result = {
   ropes: motion.ropes.map((r) => ({ part: r.part, segments: r.slots.length })),
   node: process.version, v8Flags: process.execArgv,
   allocation: await allocation(motion),
+  live: liveBytes(motion),
 };
 if (options.only !== 'allocation') result.step = stepCost(motion);
 if (motion.ropes.length && options.only !== 'allocation') {

@@ -112,14 +112,17 @@ def measure(package: Path, options: dict[str, Any]) -> dict[str, Any]:
 
 def table(results: list[dict[str, Any]]) -> str:
     lines = [
-        "| package | type | slots | µs/step (median) | bytes/step | GCs | rope µs per substep·pass·segment |",
-        "|---|---|---|---|---|---|---|",
+        "| package | type | slots | µs/step (median) | step p50 | step p95 | step max | bytes/step | GCs "
+        "| live kB/body | rope µs per substep·pass·segment |",
+        "|---|---|---|---|---|---|---|---|---|---|---|",
     ]
     for r in results:
         rope = f"{r['rope']['usPerUnit']:.3f}" if "rope" in r else "-"
+        one = r["step"]["perStep"]
         lines.append(
-            f"| {r['package']} | {r['type']} | {r['slots']} | {r['step']['median']:.2f} | "
-            f"{r['allocation']['bytesPerStep']:.1f} | {r['allocation']['collections']} | {rope} |"
+            f"| {r['package']} | {r['type']} | {r['slots']} | {r['step']['median']:.2f} | {one['p50']:.2f} | "
+            f"{one['p95']:.2f} | {one['max']:.2f} | {r['allocation']['bytesPerStep']:.1f} | "
+            f"{r['allocation']['collections']} | {r['live']['perBodyBytes'] / 1024:.1f} | {rope} |"
         )
     return "\n".join(lines)
 
@@ -166,8 +169,10 @@ def main(argv: Sequence[str] | None = None) -> int:
         "results": results,
         "notes": (
             "Node runs each package's own core/ (the code the population calls per fixed step). Step cost is "
-            "wall time per creature per step, median of rounds; allocation is V8 heapUsed growth over the "
-            "steps after a full collection, with the collections a gc PerformanceObserver saw; rope cost is "
+            "wall time per creature per step, median of rounds, and p50/p95/max of single steps of the whole "
+            "population (perStep, µs per creature); allocation is V8 heapUsed growth over the "
+            "steps after a full collection, with the collections a gc PerformanceObserver saw; live is the "
+            "bodies' heap after full collections (peak over checkpoints, per body); rope cost is "
             "the step cost minus the same creature without ropes, fitted against substeps*passes*segments."
         ),
         "wall_seconds": time.perf_counter() - started,

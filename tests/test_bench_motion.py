@@ -43,6 +43,14 @@ def test_motion_benchmark_smoke(
     assert result["step"]["median"] > 0
     assert len(result["step"]["samples"]) == 2
     assert result["allocation"]["steps"] == 50
+    one = result["step"]["perStep"]
+    assert one["steps"] == 2 * 20
+    assert 0 < one["p50"] <= one["p95"] <= one["max"]
+    live = result["live"]
+    assert live["bodies"] == 2
+    assert len(live["checkpoints"]) == 6
+    assert live["peakLiveBytes"] == max(live["checkpoints"]) > 0  # two bodies hold state
+    assert live["perBodyBytes"] == live["peakLiveBytes"] / 2
     rope = result["rope"]
     segments = sum(r["segments"] for r in result["ropes"])
     assert [c["work"] for c in rope["configs"]] == [s * p * segments for s, p in ((1, 2), (2, 4), (4, 8))]

@@ -76,6 +76,14 @@ def test_runtime_benchmark_smoke(tmp_path: Path, capsys: pytest.CaptureFixture[s
     assert workload["K"] == result["build_report_workload"]["K"]
     assert workload["vertices"] == result["build_report_workload"]["vertices"]
     assert workload["shadow_passes"] == [0]
+    built = result["build_report_workload"]
+    assert workload["visible_instances"] == [[n] for n in BODIES]
+    assert (workload["S"], workload["influences"]) == (built["S"], built["influences"])
+    assert 1 <= workload["influences"] <= 4
+    assert sum(workload["skinning_methods"].values()) == workload["vertices"]
+    assert workload["outline_mode"] == "none"
+    assert workload["render_extent"] == [192, 144]
+    assert workload["sample_count"] == 0  # the bench's renderer: antialias off
     model = result["model"]
     assert model["predicted_ratio_7P_over_K"] == 7 * workload["slots"] / workload["K"]
 
@@ -100,6 +108,10 @@ def test_runtime_benchmark_smoke(tmp_path: Path, capsys: pytest.CaptureFixture[s
             assert _positive_finite(timing["ms"]["p50"])
             assert timing["ms"]["p50"] <= timing["ms"]["p95"]
             assert _positive_finite(timing["cpu_ms"]["p50"])
+        first = population["first_frame_ms"]
+        assert set(first) == {*bench.VARIANTS, "first_visible"}
+        assert first["first_visible"] == first["shipped"]
+        assert all(_positive_finite(first[v]) for v in bench.VARIANTS)
         assert _positive_finite(population["ratio_baseline_over_shipped"]["median"])
         assert _positive_finite(population["ratio_shipped_over_lbs"]["median"])
 

@@ -59,6 +59,15 @@ class Workload(JsonRecord):
     leaf_evaluations_per_body: int
     pose_bytes_per_body: int
     deform_bytes_per_body: int
+    S: int
+    """Correction trials a corrected vertex may spend after its initial query (the shared budget),
+    rejected backtracking trials included: its snap evaluates its program at most S + 1 times."""
+    influences: int
+    """The most skin influences (non-zero weights) any vertex has; at most 4."""
+    skinning_methods: dict[str, int]
+    """Vertices per skinning method (lbs, dq, cor), as each vertex's joint chose."""
+    outline_mode: str
+    """The outline the package draws: "none" (no outline pass is built yet)."""
 
 
 @dataclass(frozen=True, slots=True)

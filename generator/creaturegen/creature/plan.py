@@ -157,7 +157,6 @@ def build_plan(
     tapes, assets = list(first.tapes), first.assets
     runtime = _runtime(spec, rig, spec_sha256, skeleton, motion, tuple(t.data for t in tiers))
     workload = _workload(rig, surface, runtime, tapes)
-    skin = np.asarray(surface.asset.skin)  # (V, 2): method code, trust radius
     plan = PackagePlan(
         name=spec.name,
         slug=runtime.slug,
@@ -179,7 +178,7 @@ def build_plan(
         gates=tuple(g.as_dict() for g in surface.gates),
         representation=_representation(workload.field_vertices, surface.asset.vertex_count),
         workload=workload,
-        methods={m: int(np.count_nonzero(skin[:, 0] == i)) for i, m in enumerate(METHODS)},
+        methods=workload.skinning_methods,
         types=TypeUnions(DEBUG_MODES, tuple(TIERS), get_args(LocomotionType), data_declarations()),
     )
     return CreaturePlan(plan, runtime, first.tapes, skeleton, first.program, tiers)
@@ -291,4 +290,8 @@ def _workload(rig: CompiledRig, surface: SurfaceBuild, runtime: CreatureData, ta
         pose_bytes_per_body=runtime.max_parts * POSE_ROWS * 16,
         # The deform pre-pass storage (tsl/deform.js DEFORM_STRIDE vec4 per vertex).
         deform_bytes_per_body=asset.vertex_count * DEFORM_STRIDE * 16,
+        S=runtime.correction.budget,
+        influences=int(np.count_nonzero(np.asarray(asset.weights) > 0, axis=1).max()),
+        skinning_methods={m: int(np.count_nonzero(skin[:, 0] == i)) for i, m in enumerate(METHODS)},
+        outline_mode="none",
     )

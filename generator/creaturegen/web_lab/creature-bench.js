@@ -314,6 +314,8 @@ async function main() {
         floatsPerInstance: data.maxParts * pkg.POSE_ROWS * 4, bodyScale: L, canvas: [width, height],
         drawingBuffer: [canvas.width, canvas.height], spacing, frameBodies, fdStep: step,
         shadows, shadowMapSize: shadows ? [sun.shadow.mapSize.x, sun.shadow.mapSize.y] : null, signatures: data.signatures,
+        // MSAA samples of the frames the bench times (three's renderer.samples; 0: no multisampling).
+        sampleCount: renderer.samples,
       };
     },
     setVariant(v) { setVariant(v); return v; },
