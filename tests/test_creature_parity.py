@@ -616,3 +616,43 @@ def test_the_job_catches_a_wrong_debug_shell(
     package = build("reference/hopper.json", out_root)
     failed, summary = _failures(package, tmp_path, "shell.js", [swap], ("shell",))
     assert gate in failed, summary
+
+
+@pytest.mark.browser
+@pytest.mark.parametrize(
+    ("file", "swaps", "gate"),
+    [
+        (
+            "material.js",
+            [
+                ("  material.roughnessNode = look.roughness;\n", ""),
+                ("  material.metalnessNode = look.metalness;\n", ""),
+            ],
+            "front view under setLook",
+        ),
+        (
+            "population.js",
+            [
+                (
+                    "for (const [name, value] of Object.entries(changes)) state.look[name].value = value;",
+                    "for (const page of pages) {\n"
+                    "        const m = page.mesh.material.clone();\n"
+                    "        m.roughnessNode = null;\n"
+                    "        m.roughness = changes.roughness ?? 0.55;\n"
+                    "        page.mesh.material = m;\n"
+                    "      }",
+                )
+            ],
+            "GPU objects created by setLook",
+        ),
+    ],
+    ids=["look-not-in-the-shader", "look-rebuilds-materials"],
+)
+def test_the_job_catches_a_look_that_is_not_a_uniform_write(
+    file: str, swaps: list[tuple[str, str]], gate: str, out_root: Path, tmp_path: Path
+) -> None:
+    """Controls the material never reads (the picture does not change), or a setLook that marks every
+    material for a rebuild (the device creates objects)."""
+    package = build("reference/hopper.json", out_root)
+    failed, summary = _failures(package, tmp_path, file, swaps, ("look",))
+    assert any(name.startswith(gate) for name in failed), summary

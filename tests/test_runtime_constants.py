@@ -105,3 +105,24 @@ def test_creature_data_does_not_echo_the_runtime_constants() -> None:
         for name in MOVED:
             assert f"CREATURE.{json_name(name)}" not in source, (path, name)
             assert f"data.{json_name(name)}" not in source, (path, name)
+
+
+def test_set_look_ranges_are_the_spec_ones() -> None:
+    """tsl/material.js LOOK_RANGES (what setLook accepts) against the spec's Look model (what a spec may
+    say): the same controls, bounds and open or closed lower ends."""
+    from annotated_types import Ge, Gt, Le
+
+    from creaturegen.spec.character import Look
+
+    source = (templates_dir("creature") / "tsl/material.js").read_text()
+    (body,) = re.findall(r"^export const LOOK_RANGES = Object\.freeze\(\{(.+)\}\);$", source, re.M)
+    js = {
+        name: (float(lo), float(hi), closed == "true")
+        for name, lo, hi, closed in re.findall(r"(\w+): \[([\d.]+), ([\d.]+), (true|false)\]", body)
+    }
+    spec = {}
+    for name, info in Look.model_fields.items():
+        bounds = {type(m): m for m in info.metadata}
+        low = bounds[Ge].ge if Ge in bounds else bounds[Gt].gt
+        spec[name] = (float(low), float(bounds[Le].le), Ge in bounds)
+    assert js == spec

@@ -34,7 +34,7 @@ from ..surface.skinning import METHODS
 from .assets import AssetNames, asset_plan
 from .package_plan import PackagePlan, ThreeRelease, TierAssets, TypeUnions, Usage, Workload
 from .pose import POSE_ROWS
-from .runtime import CorrectionData, CreatureData, MeshCounts, TierData, data_declarations
+from .runtime import CorrectionData, CreatureData, LookData, MeshCounts, TierData, data_declarations
 from .tape import Tape, compile_tape
 
 #: The runtime's debug views (lab `setDebugMode`; tsl/material.js DEBUG_MODES); "shell" is the diagnostic
@@ -226,6 +226,7 @@ def _runtime(
         tiny=float(np.finfo(np.float32).tiny),
         k_floor=floors.k_floor,
         correction=CorrectionData(correction.DEFAULT_BUDGET, correction.EARLY_OUT, correction.GRADIENT_FLOOR),
+        look=LookData(spec.look.roughness, spec.look.metalness, spec.look.distanceRange),
         mesh=first.mesh,
         projected_size_max_px=first.projected_size_max_px,
         tiers=tiers,

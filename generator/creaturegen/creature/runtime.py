@@ -34,6 +34,16 @@ class CorrectionData(JsonRecord):
 
 
 @dataclass(frozen=True, slots=True)
+class LookData(JsonRecord):
+    """The shading controls at spawn (the spec's ``look``): tsl/material.js reads them as uniforms."""
+
+    roughness: float
+    metalness: float
+    distance_range: float
+    """The 'distance' debug view's colour range, a fraction of the body scale."""
+
+
+@dataclass(frozen=True, slots=True)
 class MeshCounts(JsonRecord):
     """The reference surface's size."""
 
@@ -104,6 +114,7 @@ class CreatureData(JsonRecord):
     tiny: float
     k_floor: float
     correction: CorrectionData
+    look: LookData
     mesh: MeshCounts
     projected_size_max_px: float
     """The largest size of the body's length L on screen, in pixels, at which this tier's surface stays

@@ -17,6 +17,8 @@ Gates, all measured in the run (thresholds are relative to the body scale L wher
 - debug shell (the 'shell' view): vertices per slot vs the seed's (2 + 2·capRings)·radial + 2 for the tier,
   every slot's shell placed on its pose row and snapped onto the union field, GPU vs numpy
   (creature_shell.py);
+- look: setLook (roughness, metalness) changes the picture and creates no GPU object; setting the
+  package's look back restores it pixel for pixel (creature_look.py);
 - shadows: the silhouette seen from the sun vs the shadow footprint on the ground (the depth pass uses the
   same position function), max distance of a disagreeing texel to the other mask's edge;
 - no GPU validation errors; no pipelines and no buffers created by a burst of spawns that fills the lab's
@@ -46,6 +48,7 @@ from pathlib import Path
 
 from ..creature import reference as cref
 from .creature_lab import DEFAULT_CANVAS, LAB_POSITION, LAB_SEED, PARITY_TICK, open_creature_lab_page
+from .creature_look import look_gates
 from .creature_population import (
     GRID_SIDE,
     PAGE_SIZE,
@@ -63,7 +66,19 @@ from .creature_tiers import shipped_ceilings, tier_gates
 from .creature_views import pictures, shadow_gate
 from .report import ParityReport, adapter_gate, console_problems
 
-GATE_GROUPS = ("population", "hash", "field", "motion", "skin", "shell", "shadow", "cull", "tiers", "grid")
+GATE_GROUPS = (
+    "population",
+    "hash",
+    "field",
+    "motion",
+    "skin",
+    "shell",
+    "look",
+    "shadow",
+    "cull",
+    "tiers",
+    "grid",
+)
 
 
 def run_creature_parity(
@@ -105,6 +120,7 @@ def run_creature_parity(
         phase("skin", lambda: skin_gates(page, ref, motion, report))
         finest = json.loads((package / "build-report.json").read_text())["tier"]
         phase("shell", lambda: shell_gates(page, ref, motion, finest, report))
+        phase("look", lambda: look_gates(page, report))
         # A package shipping several tiers: bodies moved between them by their size on screen. Before the
         # shadow gate, whose edits of the page materials make every page rebuild its bindings when next
         # drawn (the lab's doing, which the walk's device count would charge to the tier moves); it puts

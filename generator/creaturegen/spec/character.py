@@ -340,6 +340,22 @@ class NaryBlend(StrictModel):
 Blend = Annotated[TreeBlend | NaryBlend, Field(discriminator="mode")]
 
 
+class Look(StrictModel):
+    """How the body is shaded. Each control is a uniform of the one material every page shares, so changing
+    it at run time (``population.setLook``) is a uniform write: no material, pipeline or buffer is made."""
+
+    roughness: Annotated[Number, Field(ge=0, le=1)] = Field(
+        default=0.55, description="Surface roughness of the physically based material (0 mirror, 1 matte)."
+    )
+    metalness: Annotated[Number, Field(ge=0, le=1)] = Field(
+        default=0.0, description="Metalness of the physically based material (creatures: 0)."
+    )
+    distanceRange: Annotated[Number, Field(gt=0, le=0.1)] = Field(
+        default=0.005,
+        description="The 'distance' debug view's colour range: ±this fraction of the body scale L.",
+    )
+
+
 class CharacterSpec(StrictModel):
     """A creature: round primitives blended by smooth minimum into one signed distance field."""
 
@@ -356,6 +372,7 @@ class CharacterSpec(StrictModel):
     )
     parts: Annotated[list[Part], Field(min_length=1)]
     blend: Blend | None = Field(default=None, description="Blend graph; omitted means the default graph.")
+    look: Look = Field(default_factory=Look, description="Shading controls (uniforms: setLook changes them).")
     maxParts: Annotated[StrictInt, Field(ge=1, le=256)] = Field(
         default=64, description="Slot capacity per creature in the pose pages."
     )

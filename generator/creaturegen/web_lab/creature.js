@@ -476,6 +476,32 @@ async function main() {
     },
     async readPose(i = 0) { return Array.from(await diag.readPose(i)); },
     /**
+     * The shading controls as uniforms: the front view under the current look, under `changes` and under
+     * the current look again, with the device objects created from the first setLook to the last capture.
+     */
+    async lookCheck(changes) {
+      const before = { ...pop.look };
+      const target = targetFor(width, height);
+      const frame = () => { renderer.setRenderTarget(target); renderer.render(scene, camera); renderer.setRenderTarget(null); };
+      // A readback makes its own staging buffer: only setLook and the renders are inside the counted window.
+      frame();
+      const a = await readTarget(target, width, height);
+      const created = {};
+      const count = async (change) => {
+        const start = { ...deviceCounts };
+        const now = pop.setLook(change);
+        frame();
+        await device.queue.onSubmittedWorkDone();
+        for (const [k, v] of Object.entries(deviceCounts)) created[k] = (created[k] ?? 0) + v - start[k];
+        return now;
+      };
+      const during = await count(changes);
+      const b = await readTarget(target, width, height);
+      await count(before);
+      const c = await readTarget(target, width, height);
+      return { before, during, restored: { ...pop.look }, created, width, height, rgba: [a, b, c].map(toBase64) };
+    },
+    /**
      * Body i's debug shell through the package's shellVertex (creature-local), and the vertex count of the
      * shell mesh the 'shell' view draws (the view is built, not drawn, and the mode put back).
      */

@@ -2,7 +2,7 @@
 // (also exported by `./tsl`). The three.js types come from @types/three, an optional peer dependency.
 import type { Camera, Group, Light, Mesh, Object3D, WebGPURenderer } from 'three/webgpu';
 import type {
-  DebugMode, Driver, GravityProvider, Motion, SupportSurfaceProvider, TierName, WaterSurfaceProvider,
+  DebugMode, Driver, GravityProvider, LookData, Motion, SupportSurfaceProvider, TierName, WaterSurfaceProvider,
 } from './core/index.js';
 
 export * from './core/index.js';
@@ -20,6 +20,8 @@ export interface PopulationOptions {
   /** At most this many bodies in a tier at once (default: capacity for each). */
   tierCapacity?: Partial<Record<TierName, number>>;
   debugMode?: DebugMode;
+  /** Shading controls over CREATURE.look (roughness, metalness in [0, 1]; distanceRange in (0, 0.1]). */
+  look?: Partial<LookData>;
   /** The surface .glb's own URL (e.g. what a bundler's file loader returned for
    *  `<package>/assets/<CREATURE.surfaceFile>`). Default: the package's copy, `new URL(..., import.meta.url)`. */
   surfaceUrl?: string | URL | Partial<Record<TierName, string | URL>>;
@@ -122,6 +124,11 @@ export interface CreaturePopulation {
   instance(id: number): InstanceInfo;
   stateHash(): string;
   setDebugMode(mode: DebugMode): void;
+  /** The shading controls now (CREATURE.look at creation, then what setLook wrote). */
+  readonly look: LookData;
+  /** Change shading controls: uniform writes, no material, pipeline or buffer created; throws a RangeError
+   *  naming a control that is unknown or out of range. Returns the controls now. */
+  setLook(changes: Partial<LookData>): LookData;
   /**
    * Cull bodies by their posed bounds against these cameras or shadow-casting lights at every flush: only
    * bodies one of them sees are deformed and drawn. No arguments: no culling (the default).

@@ -3,7 +3,7 @@
 import type {
   BufferGeometry, ComputeNode, Mesh, MeshStandardNodeMaterial, Node, StorageBufferNode, WebGPURenderer,
 } from 'three/webgpu';
-import type { CreatureData, DebugMode, ParsedSurface, TierName } from '../core/index.js';
+import type { CreatureData, DebugMode, LookData, ParsedSurface, TierName } from '../core/index.js';
 
 export type {
   CreaturePopulation, InstanceInfo, PopulationOptions, SpawnOptions,
@@ -91,7 +91,13 @@ export function dispatchDeform(renderer: WebGPURenderer, deform: DeformKernel, c
 
 /** Throws unless `mode` is one of DEBUG_MODES; returns it. */
 export function checkDebugMode(mode: string): DebugMode;
-export function createBodyMaterial(layout: Layout, pose: PoseStorage, deform: PoseStorage, drawList: PoseStorage, mode: DebugMode): MeshStandardNodeMaterial;
+/** The population's shading uniforms (one set shared by every page and variant). */
+export interface LookUniforms { roughness: Node & { value: number }; metalness: Node & { value: number }; distanceRange: Node & { value: number } }
+export function createLookUniforms(look: LookData): LookUniforms;
+/** setLook's controls: [lowest, highest, lowest allowed]. */
+export const LOOK_RANGES: Readonly<Record<keyof LookData, readonly [number, number, boolean]>>;
+export function checkLook<T extends Partial<LookData>>(changes: T): T;
+export function createBodyMaterial(layout: Layout, pose: PoseStorage, deform: PoseStorage, drawList: PoseStorage, mode: DebugMode, look: LookUniforms): MeshStandardNodeMaterial;
 export function rootRotate(root1: Node, v: Node): Node;
 export function rootPoint(root1: Node, p: Node): Node;
 export function rootNormal(root1: Node, n: Node): Node;

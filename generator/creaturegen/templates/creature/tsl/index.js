@@ -7,7 +7,9 @@ export {
   DEFORM_STRIDE, RECORD_STRIDE, createDeformKernel, deformStorage, deformView, dispatchDeform, instanceList, recordInputs,
   PATHS, vertexOrder, vertexRecords,
 } from './deform.js';
-export { DEBUG_MODES, checkDebugMode, createBodyMaterial, rootNormal, rootPoint, rootRotate } from './material.js';
+export {
+  DEBUG_MODES, LOOK_RANGES, checkDebugMode, checkLook, createBodyMaterial, createLookUniforms, rootNormal, rootPoint, rootRotate,
+} from './material.js';
 export {
   SHELL_CAP_RINGS, SHELL_RADIAL, SHELL_SNAP_STEPS, SHELL_TIERS, createShellMesh, shellCounts, shellGeometry, shellVertex,
 } from './shell.js';

@@ -9,7 +9,7 @@
 // the same way (the 'distance' view shows it on the surface, 'candidates' gives it its own colour).
 import * as THREE from 'three/webgpu';
 import {
-  Fn, attribute, clamp, float, fract, instanceIndex, int, mix, normalLocal, normalize, select, sin,
+  Fn, attribute, clamp, float, fract, instanceIndex, int, mix, normalLocal, normalize, select, sin, uniform,
   varyingProperty, vec3, vertexIndex,
 } from 'three/tsl';
 import { DEFORM_STRIDE } from './deform.js';
@@ -42,12 +42,44 @@ export const rootNormal = (root1, n) => {
 };
 
 /**
+ * The shading controls as uniform nodes, one set per population and shared by every page and variant, so
+ * setting one is a single uniform write (LookData: roughness, metalness, distanceRange).
+ */
+export function createLookUniforms(look) {
+  return {
+    roughness: uniform(look.roughness, 'float'),
+    metalness: uniform(look.metalness, 'float'),
+    distanceRange: uniform(look.distanceRange, 'float'),
+  };
+}
+
+/** The shading controls setLook takes, each [lowest, highest] and whether the lowest is allowed (the spec's look). */
+export const LOOK_RANGES = Object.freeze({ roughness: [0, 1, true], metalness: [0, 1, true], distanceRange: [0, 0.1, false] });
+
+/** `changes` checked against LOOK_RANGES: throws a RangeError naming the control, else returns it. */
+export function checkLook(changes) {
+  if (changes === null || typeof changes !== 'object') throw new TypeError(`setLook: expected an object of controls (got ${changes})`);
+  for (const [name, value] of Object.entries(changes)) {
+    const range = LOOK_RANGES[name];
+    if (!range) throw new RangeError(`setLook: unknown control ${JSON.stringify(name)}; controls: ${Object.keys(LOOK_RANGES).join(', ')}`);
+    const [lo, hi, closed] = range;
+    if (typeof value !== 'number' || !Number.isFinite(value) || value > hi || value < lo || (!closed && value === lo)) {
+      throw new RangeError(`setLook: ${name} must be a number ${closed ? 'in' : 'above'} ${closed ? `[${lo}, ${hi}]` : `${lo}, at most ${hi}`} (got ${value})`);
+    }
+  }
+  return changes;
+}
+
+/**
  * The display material of a page for one debug mode (a variant; cached by the population). `deform` is
  * the page's read-only deformed-vertex view (deform.js deformView), `drawList` the page's list of drawn
- * bodies (instance i draws body drawList[i]); 'skin-only' is the same material over the skin-only pre-pass.
+ * bodies (instance i draws body drawList[i]), `look` the population's shading uniforms
+ * (createLookUniforms); 'skin-only' is the same material over the skin-only pre-pass.
  */
-export function createBodyMaterial(layout, pose, deform, drawList, mode) {
-  const material = new THREE.MeshStandardNodeMaterial({ roughness: 0.55, metalness: 0.0 });
+export function createBodyMaterial(layout, pose, deform, drawList, mode, look) {
+  const material = new THREE.MeshStandardNodeMaterial();
+  material.roughnessNode = look.roughness;
+  material.metalnessNode = look.metalness;
   const vColour = varyingProperty('vec3', 'vCgColour');
   material.positionNode = Fn(() => {
     const j = drawList.element(int(instanceIndex)).toVar();
@@ -61,7 +93,7 @@ export function createBodyMaterial(layout, pose, deform, drawList, mode) {
     const n = normalize(r1.xyz).toVar();
     let colour;
     if (mode === 'distance') {
-      const t = clamp(r0.w.div(layout.bodyScale * 0.005), -1, 1);
+      const t = clamp(r0.w.div(look.distanceRange.mul(layout.bodyScale)), -1, 1);
       colour = select(t.lessThan(0), mix(vec3(0.9), vec3(0.1, 0.3, 1.0), t.negate()), mix(vec3(0.9), vec3(1.0, 0.2, 0.1), t));
     } else if (mode === 'weights') {
       colour = hashColour(float(attribute('cgSlots', 'vec4').x).add(1)).mul(attribute('cgWeights', 'vec4').x);

@@ -57,14 +57,16 @@ export function createPages(state, tier, index) {
 /** The pre-pass variant of a debug mode: 'skin-only' stores uncorrected positions, every other mode the body. */
 export const kernelKind = (m) => (m === 'skin-only' ? 'skin-only' : 'body');
 
-// One material per (signatures, tier, mode, registers) and page: built on first use, kept for reuse.
+// One material per (signatures, tier, outline, mode, registers) and page: built on first use, kept for reuse.
+// The look (roughness, metalness, the distance view's range) is not in the key: it is uniforms every variant
+// shares (state.look), written by setLook. The outline term is 'none': no outline pass is built yet.
 function materialFor(state, page, m) {
   const { variants } = state;
   const { data, layout } = page.tier;
   const shown = m === 'shell' ? 'off' : m;
-  const key = `${[data.signatures.compilerSignature, data.signatures.topologySignature, data.tier, shown, data.registers].join('|')}`
+  const key = `${[data.signatures.compilerSignature, data.signatures.topologySignature, data.tier, 'outline:none', shown, data.registers].join('|')}`
     + `|page${page.index}`;
-  if (!variants.has(key)) variants.set(key, createBodyMaterial(layout, page.pose, page.deformView, page.drawList, shown));
+  if (!variants.has(key)) variants.set(key, createBodyMaterial(layout, page.pose, page.deformView, page.drawList, shown, state.look));
   return variants.get(key);
 }
 

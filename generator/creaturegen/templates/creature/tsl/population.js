@@ -17,7 +17,7 @@ import { POSE_ROWS } from '../core/pose.js';
 import { checkThreeRevision } from '../core/surface.js';
 import { dispatchDeform } from './deform.js';
 import { registerInternals } from './internals.js';
-import { checkDebugMode } from './material.js';
+import { checkDebugMode, checkLook, createLookUniforms } from './material.js';
 import { createPages, kernelKind, showMode } from './pages.js';
 import { advance, clearSlot, deformAll, flush, freeSlot, locate, writeCurrent, writeInstance } from './staging.js';
 import { chooseTiers, loadTiers, moveBody, tierCount, tierNames } from './tiers.js';
@@ -72,7 +72,7 @@ export function assertThreeRevision(revision = THREE.REVISION) {
  * every one: CREATURE.tiers), tier (the tier spawn() puts a body in, default the finest loaded),
  * tierCapacity ({ tier: bodies } at most in that tier, default capacity each), pageSize (bodies per page
  * and draw, at most what one storage binding of the device holds: DEFORM_STRIDE·16 bytes per vertex per
- * body, default 64), debugMode, surfaceUrl (the .glb's URL; { tier: URL } for several tiers) or assetBase
+ * body, default 64), debugMode, look (shading controls over CREATURE.look, see setLook), surfaceUrl (the .glb's URL; { tier: URL } for several tiers) or assetBase
  * (the folder holding the tiers' surfaceFile; default: this package's own assets/), support (a
  * SupportSurfaceProvider, default flat ground at y = 0), gravity (a gravity provider, default standard
  * gravity), water (a WaterSurfaceProvider: required for a swimmer, which is refused without one).
@@ -122,6 +122,8 @@ export async function createCreaturePopulation(renderer, options = {}) {
     views: [], planes: new Float64Array(0), groupMatrix: new Float64Array(16), viewsChanged: false,
     tick: 0,
     mode: checkDebugMode(options.debugMode ?? 'off'),
+    // The shading controls, one set of uniforms for every page and variant (setLook writes them).
+    look: createLookUniforms({ ...data.look, ...checkLook(options.look ?? {}) }),
   };
   const tiers = await loadTiers(state, names, options, (surface) => ({ geometry: surfaceGeometry(surface), programs: programStorage(surface) }));
   state.tiers = tiers;
@@ -307,6 +309,20 @@ export async function createCreaturePopulation(renderer, options = {}) {
     },
     stateHash() {
       return hashBytes(pages.map((p) => new Uint8Array(p.staging.buffer, p.staging.byteOffset, p.staging.byteLength)), state.tick);
+    },
+    /** The shading controls now: { roughness, metalness, distanceRange } (CREATURE.look at creation). */
+    get look() {
+      return { roughness: state.look.roughness.value, metalness: state.look.metalness.value, distanceRange: state.look.distanceRange.value };
+    },
+    /**
+     * Change shading controls ({ roughness?, metalness?, distanceRange? }, each in the spec's range): uniform
+     * writes seen from the next render, shared by every page and debug view; no material, pipeline or buffer
+     * is created. Throws a RangeError naming the control for an unknown one or a value out of range.
+     */
+    setLook(changes) {
+      checkLook(changes);
+      for (const [name, value] of Object.entries(changes)) state.look[name].value = value;
+      return population.look;
     },
     /** Switch every page to debug mode `m` (a variant built on first use; 'off' is the shipped one). */
     setDebugMode(m) {

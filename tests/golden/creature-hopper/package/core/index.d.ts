@@ -195,6 +195,14 @@ export interface CorrectionData {
   readonly gradientFloor: number;
 }
 
+/** The shading controls at spawn (the spec's `look`): tsl/material.js reads them as uniforms. */
+export interface LookData {
+  readonly roughness: number;
+  readonly metalness: number;
+  /** The 'distance' debug view's colour range, a fraction of the body scale. */
+  readonly distanceRange: number;
+}
+
 /** The reference surface's size. */
 export interface MeshCounts {
   readonly vertices: number;
@@ -265,6 +273,7 @@ export interface CreatureData {
   readonly tiny: number;
   readonly kFloor: number;
   readonly correction: CorrectionData;
+  readonly look: LookData;
   readonly mesh: MeshCounts;
   /**
    * The largest size of the body's length L on screen, in pixels, at which this tier's surface stays within
