@@ -656,3 +656,28 @@ def test_the_job_catches_a_look_that_is_not_a_uniform_write(
     package = build("reference/hopper.json", out_root)
     failed, summary = _failures(package, tmp_path, file, swaps, ("look",))
     assert any(name.startswith(gate) for name in failed), summary
+
+
+@pytest.mark.browser
+@pytest.mark.parametrize(
+    ("file", "swap"),
+    [
+        ("body.js", ("reach.mul(float(i.add(1)))", "reach.mul(float(i.add(2)))")),
+        (
+            "population.js",
+            (
+                "if (Object.keys(changes).some((name) => LOOK_DEFORM.includes(name))) "
+                "for (const page of pages) deformAll(state, page);",
+                "",
+            ),
+        ),
+    ],
+    ids=["taps-one-step-too-far", "setlook-without-re-deform"],
+)
+def test_the_job_catches_a_wrong_self_occlusion(
+    file: str, swap: tuple[str, str], out_root: Path, tmp_path: Path
+) -> None:
+    """Occlusion taps placed one step too far out, or a setLook that leaves the stored albedo as it was."""
+    package = build("reference/hopper.json", out_root)
+    failed, summary = _failures(package, tmp_path, file, [swap], ("look",))
+    assert any(name.startswith("self-occlusion (") for name in failed), summary

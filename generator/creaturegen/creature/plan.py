@@ -184,6 +184,11 @@ def build_plan(
     return CreaturePlan(plan, runtime, first.tapes, skeleton, first.program, tiers)
 
 
+def _look(spec: CharacterSpec) -> LookData:
+    look = spec.look
+    return LookData(look.roughness, look.metalness, look.distanceRange, look.aoTaps, look.aoRadius)
+
+
 def _runtime(
     spec: CharacterSpec,
     rig: CompiledRig,
@@ -226,7 +231,7 @@ def _runtime(
         tiny=float(np.finfo(np.float32).tiny),
         k_floor=floors.k_floor,
         correction=CorrectionData(correction.DEFAULT_BUDGET, correction.EARLY_OUT, correction.GRADIENT_FLOOR),
-        look=LookData(spec.look.roughness, spec.look.metalness, spec.look.distanceRange),
+        look=_look(spec),
         mesh=first.mesh,
         projected_size_max_px=first.projected_size_max_px,
         tiers=tiers,

@@ -198,3 +198,24 @@ def baked_colours(ref: PackageReference, seed: int) -> F64:
     weights = np.asarray(asset.colour_weights).astype(np.float64)
     result: F64 = np.einsum("vk,vkc->vc", weights, rgb[slots]) / weights.sum(axis=1, keepdims=True)
     return result
+
+
+def self_occlusion(
+    ref: PackageReference, table: F64, points: F64, gradients: F64, size: float, taps: int, radius: float
+) -> F64:
+    """(P,) tsl/body.js selfOcclusion in float64: ``taps`` taps of the full field at δᵢ = r·i/taps along
+    n̂ = g/|g| (r = radius·L·size, i = 1..taps), each counting max(δᵢ − d, 0)/δᵢ with weight 2⁻ⁱ,
+    normalised; 1 − that, clamped to [0, 1]. Ones when ``taps`` is 0."""
+    if taps == 0:
+        return np.ones(len(points))
+    n = gradients / np.maximum(np.linalg.norm(gradients, axis=1, keepdims=True), 1e-300)
+    reach = radius * ref.rig.body_scale * size
+    occlusion = np.zeros(len(points))
+    total = 0.0
+    for i in range(1, taps + 1):
+        delta = reach * i / taps
+        d = np.asarray(field_at(ref, table, points + n * delta, size).distance, dtype=np.float64)
+        occlusion += 0.5**i * np.maximum(delta - d, 0.0) / delta
+        total += 0.5**i
+    result: F64 = np.clip(1.0 - occlusion / total, 0.0, 1.0)
+    return result

@@ -41,6 +41,10 @@ class LookData(JsonRecord):
     metalness: float
     distance_range: float
     """The 'distance' debug view's colour range, a fraction of the body scale."""
+    ao_taps: int
+    """Field self-occlusion taps along each vertex's normal (0: off)."""
+    ao_radius: float
+    """How far the occlusion taps reach, a fraction of the body scale."""
 
 
 @dataclass(frozen=True, slots=True)

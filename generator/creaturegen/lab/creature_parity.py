@@ -48,7 +48,7 @@ from pathlib import Path
 
 from ..creature import reference as cref
 from .creature_lab import DEFAULT_CANVAS, LAB_POSITION, LAB_SEED, PARITY_TICK, open_creature_lab_page
-from .creature_look import look_gates
+from .creature_look import look_and_occlusion
 from .creature_population import (
     GRID_SIDE,
     PAGE_SIZE,
@@ -120,7 +120,7 @@ def run_creature_parity(
         phase("skin", lambda: skin_gates(page, ref, motion, report))
         finest = json.loads((package / "build-report.json").read_text())["tier"]
         phase("shell", lambda: shell_gates(page, ref, motion, finest, report))
-        phase("look", lambda: look_gates(page, report))
+        phase("look", lambda: look_and_occlusion(page, ref, motion, report))
         # A package shipping several tiers: bodies moved between them by their size on screen. Before the
         # shadow gate, whose edits of the page materials make every page rebuild its bindings when next
         # drawn (the lab's doing, which the walk's device count would charge to the tier moves); it puts

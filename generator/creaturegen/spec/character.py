@@ -354,6 +354,15 @@ class Look(StrictModel):
         default=0.005,
         description="The 'distance' debug view's colour range: ±this fraction of the body scale L.",
     )
+    aoTaps: Annotated[StrictInt, Field(ge=0, le=8)] = Field(
+        default=0,
+        description="Field self-occlusion: distance taps along each vertex's normal (0: off). Darkens the "
+        "albedo where the body folds onto itself (intra-body only); costs aoTaps field evaluations per "
+        "vertex and deform.",
+    )
+    aoRadius: Annotated[Number, Field(gt=0, le=0.25)] = Field(
+        default=0.05, description="How far along the normal the occlusion taps reach, a fraction of L."
+    )
 
 
 class CharacterSpec(StrictModel):

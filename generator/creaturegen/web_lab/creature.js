@@ -509,8 +509,9 @@ async function main() {
       const r = await diag.readShell(i);
       const mode = pop.debugMode;
       pop.setDebugMode('shell');
-      let drawnVertices = -1;
-      scene.traverse((o) => { if (o.isMesh && o.name.endsWith('.shell')) drawnVertices = o.geometry.attributes.position.count; });
+      // The shells of the pages of the tier the diagnostics read (the finest loaded): one count, or -1.
+      const counts = new Set(pop.pages.filter((p) => p.shell && p.tier.name === pop.tiers[0].name).map((p) => p.shell.geometry.attributes.position.count));
+      const drawnVertices = counts.size === 1 ? [...counts][0] : -1;
       pop.setDebugMode(mode);
       return { counts: r.counts, placed: Array.from(r.placed), position: Array.from(r.position), distance: Array.from(r.distance), drawnVertices };
     },
@@ -567,6 +568,36 @@ async function main() {
       return { skinned: toBase64(new Uint8Array(r.skinned.buffer)), corrected: toBase64(new Uint8Array(r.corrected.buffer)),
         accepted: toBase64(new Uint8Array(r.accepted.buffer)), gradient: toBase64(new Uint8Array(r.gradient.buffer)),
         distance: toBase64(new Uint8Array(r.distance.buffer)) };
+    },
+    /**
+     * The field's self-occlusion: body i's deform storage under the current look, then under `changes`
+     * (occlusion taps: setLook re-deforms every live body), then the look put back, with the device objects
+     * created and the pre-pass dispatches run across both changes.
+     */
+    async aoCheck(changes, i = 0) {
+      const before = { ...pop.look };
+      const read = async () => {
+        const r = await diag.readDeformed(i);
+        return { position: toBase64(new Uint8Array(r.position.buffer)), gradient: toBase64(new Uint8Array(r.gradient.buffer)),
+          colour: toBase64(new Uint8Array(r.colour.buffer)), program: toBase64(new Uint8Array(r.program.buffer)) };
+      };
+      const off = await read();
+      const created = {};
+      const change = async (c) => {
+        const start = { ...deviceCounts };
+        const deformed = pop.stats.deformDispatches;
+        pop.setLook(c);
+        pop.flush();
+        render();
+        await device.queue.onSubmittedWorkDone();
+        for (const [k, v] of Object.entries(deviceCounts)) created[k] = (created[k] ?? 0) + v - start[k];
+        return pop.stats.deformDispatches - deformed;
+      };
+      const dispatches = await change(changes);
+      const on = await read();
+      await change(before);
+      const back = await read();
+      return { look: { ...changes }, dispatches, created, off, on, back };
     },
     /** What the display and shadow passes draw (the page's deform storage), read back. */
     async readDeformed(i = 0) {

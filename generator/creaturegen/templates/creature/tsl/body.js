@@ -8,7 +8,7 @@
 // vertex, its centre of rotation and its correction trust radius are scaled by s before skinning, the
 // pose rows already hold the scaled slots (core/pose.js) and the field scales its blend widths (field.js),
 // so the path below is the unit body's times s.
-import { If, float, int, select, vec3 } from 'three/tsl';
+import { If, Loop, clamp, float, int, max, select, vec3 } from 'three/tsl';
 import { POSE_ROWS } from '../core/pose.js';
 import { createField } from './field.js';
 import { createSkin } from './skin.js';
@@ -39,6 +39,29 @@ export function layoutOf(data) {
   };
 }
 
+/**
+ * The field's self-occlusion at `p` (creature-local) with gradient `g`: `look.aoTaps` taps of the full program
+ * at δᵢ = r·i/R along n̂ = g/|g| (r = look.aoRadius·L·size, i = 1..R), each counting max(δᵢ − d, 0)/δᵢ with
+ * weight 2⁻ⁱ, normalised; 1 − that, clamped to [0, 1]. 1 when aoTaps is 0. Only the body's own parts
+ * occlude (intra-body; creature/reference.py self_occlusion is its numpy twin). Inline (call it in a Fn).
+ */
+export function selfOcclusion(layout, fns, p, g, base, look) {
+  const n = g.div(max(g.length(), float(layout.tiny))).toVar();
+  const reach = look.aoRadius.mul(layout.bodyScale).mul(fns.field.size(base)).toVar();
+  const taps = look.aoTaps;
+  const occlusion = float(0).toVar();
+  const total = float(0).toVar();
+  const w = float(0.5).toVar();
+  Loop(taps, ({ i }) => {
+    const delta = reach.mul(float(i.add(1))).div(float(taps)).toVar();
+    const d = fns.field.runProgram(p.add(n.mul(delta)), base, int(layout.fullProgram)).x;
+    occlusion.addAssign(w.mul(max(delta.sub(d), 0).div(delta)));
+    total.addAssign(w);
+    w.mulAssign(0.5);
+  });
+  return clamp(float(1).sub(occlusion.div(max(total, float(layout.tiny)))), 0, 1);
+}
+
 /** The field and skin node builders over one pose storage node. */
 export function bodyFunctions(layout, pose, programs) {
   const field = createField({
@@ -62,7 +85,7 @@ export function bodyFunctions(layout, pose, programs) {
  * 'corrected'; 'any' chooses per vertex.
  */
 export function bodyVertex(layout, fns, {
-  rest, slots, weights, skin, cor, normal, colourSlots, colourWeights, base, skinOnly, colour = false, path = 'any',
+  rest, slots, weights, skin, cor, normal, colourSlots, colourWeights, base, skinOnly, colour = false, path = 'any', look = null,
 }) {
   const skinVertexOnly = skin.z.greaterThan(layout.skinProgram - 0.5).and(skin.z.lessThan(layout.skinProgram + 0.5)).toVar();
   const program = select(skin.z.greaterThan(layout.skinProgram - 0.5), int(layout.fullProgram), int(skin.z)).toVar();
@@ -90,7 +113,8 @@ export function bodyVertex(layout, fns, {
     accepted.assign(corrected.accepted);
     gradient.assign(final.value.yzw);
     distance.assign(final.value.x);
-    if (colour) albedo.assign(final.colour);
+    // The albedo darkened by the field's self-occlusion (look.aoTaps taps; none at 0, the default).
+    if (colour) albedo.assign(look === null ? final.colour : final.colour.mul(selfOcclusion(layout, fns, corrected.position, final.value.yzw, base, look)));
   };
   if (path === 'skin') skinPath();
   else if (path === 'field') fieldPath(false);

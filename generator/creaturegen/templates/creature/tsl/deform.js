@@ -116,9 +116,10 @@ export function instanceList(size, name) {
  * `order` (vertexOrder). They run the bodies named by the first `count` entries of the page's instance
  * `list` (dispatchDeform), each into its own slice of the deform storage, so a body left out keeps what
  * it stored last: the population lists only the bodies whose pose rows changed since their last
- * pre-pass. Dead instances are skipped (the vertex stage draws them collapsed to the origin).
+ * pre-pass. Dead instances are skipped (the vertex stage draws them collapsed to the origin). `look` (the
+ * population's shading uniforms, createLookUniforms) adds the field's self-occlusion to the stored albedo.
  */
-export function createDeformKernel(layout, fns, { pose, records, order, deform, list, size, vertices, skinOnly = false }) {
+export function createDeformKernel(layout, fns, { pose, records, order, deform, list, size, vertices, skinOnly = false, look = null }) {
   const rowsPerInstance = layout.maxParts * layout.rows;
   const kernels = order.segments.map(({ path, start, count }) => {
     const kernel = Fn(() => {
@@ -129,7 +130,7 @@ export function createDeformKernel(layout, fns, { pose, records, order, deform, 
       const base = j.mul(rowsPerInstance).toVar();
       const alive = pose.element(base.add(layout.slotCount * layout.rows)).w;
       If(alive.greaterThan(0.5), () => {
-        const body = bodyVertex(layout, fns, { ...recordInputs(records, v), base, skinOnly, colour: true, path });
+        const body = bodyVertex(layout, fns, { ...recordInputs(records, v), base, skinOnly, colour: true, path, look });
         const o = idx.mul(DEFORM_STRIDE).toVar();
         deform.element(o).assign(vec4(body.position, body.distance));
         deform.element(o.add(1)).assign(vec4(body.gradient, body.accepted));

@@ -62,7 +62,7 @@ export const NO_PROGRAM: number;
 export const SKIN_PROGRAM: number;
 export function layoutOf(data: CreatureData): Layout;
 export function bodyFunctions(layout: Layout, pose: PoseStorage, programs: PoseStorage): BodyFunctions;
-export function bodyVertex(layout: Layout, fns: BodyFunctions, inputs: VertexInputs & { base: Node; skinOnly: boolean; colour?: boolean; path?: VertexPath | 'any' }): BodyVertex;
+export function bodyVertex(layout: Layout, fns: BodyFunctions, inputs: VertexInputs & { base: Node; skinOnly: boolean; colour?: boolean; path?: VertexPath | 'any'; look?: LookUniforms | null }): BodyVertex;
 
 /** vec4 per drawn vertex in a page's deform storage: (position, distance), (gradient, accepted), (albedo, program). */
 export const DEFORM_STRIDE: number;
@@ -84,7 +84,7 @@ export function deformView(deform: PoseStorage): PoseStorage;
 /** A page's instance list (one int per body): the bodies the next pre-pass runs. */
 export function instanceList(size: number): PoseStorage;
 export function createDeformKernel(layout: Layout, fns: BodyFunctions, options: {
-  pose: PoseStorage; records: PoseStorage; order: VertexOrder; deform: PoseStorage; list: PoseStorage; size: number; vertices: number; skinOnly?: boolean;
+  pose: PoseStorage; records: PoseStorage; order: VertexOrder; deform: PoseStorage; list: PoseStorage; size: number; vertices: number; skinOnly?: boolean; look?: LookUniforms | null;
 }): DeformKernel;
 /** Run `deform` over the first `count` bodies of its page's instance list; returns the vertices processed. */
 export function dispatchDeform(renderer: WebGPURenderer, deform: DeformKernel, count: number): number;
@@ -92,7 +92,11 @@ export function dispatchDeform(renderer: WebGPURenderer, deform: DeformKernel, c
 /** Throws unless `mode` is one of DEBUG_MODES; returns it. */
 export function checkDebugMode(mode: string): DebugMode;
 /** The population's shading uniforms (one set shared by every page and variant). */
-export interface LookUniforms { roughness: Node & { value: number }; metalness: Node & { value: number }; distanceRange: Node & { value: number } }
+export type LookUniforms = { [K in keyof LookData]: Node & { value: number } };
+/** The field's self-occlusion at p with gradient g (1 with look.aoTaps 0), inline in a Fn. */
+export function selfOcclusion(layout: Layout, fns: BodyFunctions, p: Node, g: Node, base: Node, look: LookUniforms): Node;
+export const LOOK_INTEGERS: readonly (keyof LookData)[];
+export const LOOK_DEFORM: readonly (keyof LookData)[];
 export function createLookUniforms(look: LookData): LookUniforms;
 /** setLook's controls: [lowest, highest, lowest allowed]. */
 export const LOOK_RANGES: Readonly<Record<keyof LookData, readonly [number, number, boolean]>>;

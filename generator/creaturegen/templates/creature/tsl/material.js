@@ -50,11 +50,17 @@ export function createLookUniforms(look) {
     roughness: uniform(look.roughness, 'float'),
     metalness: uniform(look.metalness, 'float'),
     distanceRange: uniform(look.distanceRange, 'float'),
+    aoTaps: uniform(look.aoTaps, 'int'),
+    aoRadius: uniform(look.aoRadius, 'float'),
   };
 }
 
 /** The shading controls setLook takes, each [lowest, highest] and whether the lowest is allowed (the spec's look). */
-export const LOOK_RANGES = Object.freeze({ roughness: [0, 1, true], metalness: [0, 1, true], distanceRange: [0, 0.1, false] });
+export const LOOK_RANGES = Object.freeze({ roughness: [0, 1, true], metalness: [0, 1, true], distanceRange: [0, 0.1, false], aoTaps: [0, 8, true], aoRadius: [0, 0.25, false] });
+/** The controls that are whole numbers. */
+export const LOOK_INTEGERS = Object.freeze(['aoTaps']);
+/** The controls the deform pre-pass reads (a change re-deforms every live body at the next flush). */
+export const LOOK_DEFORM = Object.freeze(['aoTaps', 'aoRadius']);
 
 /** `changes` checked against LOOK_RANGES: throws a RangeError naming the control, else returns it. */
 export function checkLook(changes) {
@@ -63,8 +69,9 @@ export function checkLook(changes) {
     const range = LOOK_RANGES[name];
     if (!range) throw new RangeError(`setLook: unknown control ${JSON.stringify(name)}; controls: ${Object.keys(LOOK_RANGES).join(', ')}`);
     const [lo, hi, closed] = range;
-    if (typeof value !== 'number' || !Number.isFinite(value) || value > hi || value < lo || (!closed && value === lo)) {
-      throw new RangeError(`setLook: ${name} must be a number ${closed ? 'in' : 'above'} ${closed ? `[${lo}, ${hi}]` : `${lo}, at most ${hi}`} (got ${value})`);
+    if (typeof value !== 'number' || !Number.isFinite(value) || value > hi || value < lo || (!closed && value === lo)
+      || (LOOK_INTEGERS.includes(name) && !Number.isInteger(value))) {
+      throw new RangeError(`setLook: ${name} must be ${LOOK_INTEGERS.includes(name) ? 'a whole number' : 'a number'} ${closed ? 'in' : 'above'} ${closed ? `[${lo}, ${hi}]` : `${lo}, at most ${hi}`} (got ${value})`);
     }
   }
   return changes;

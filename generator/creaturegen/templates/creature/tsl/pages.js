@@ -75,7 +75,7 @@ function kernelFor(state, page, kind) {
     const { layout, programs, records, order, vertices } = page.tier;
     const fns = bodyFunctions(layout, page.pose, programs);
     page.kernels.set(kind, createDeformKernel(layout, fns, {
-      pose: page.pose, records, order, deform: page.deform, list: page.list, size: page.size, vertices, skinOnly: kind === 'skin-only',
+      pose: page.pose, records, order, deform: page.deform, list: page.list, size: page.size, vertices, skinOnly: kind === 'skin-only', look: state.look,
     }));
   }
   return page.kernels.get(kind);

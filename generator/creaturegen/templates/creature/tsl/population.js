@@ -17,7 +17,7 @@ import { POSE_ROWS } from '../core/pose.js';
 import { checkThreeRevision } from '../core/surface.js';
 import { dispatchDeform } from './deform.js';
 import { registerInternals } from './internals.js';
-import { checkDebugMode, checkLook, createLookUniforms } from './material.js';
+import { LOOK_DEFORM, checkDebugMode, checkLook, createLookUniforms } from './material.js';
 import { createPages, kernelKind, showMode } from './pages.js';
 import { advance, clearSlot, deformAll, flush, freeSlot, locate, writeCurrent, writeInstance } from './staging.js';
 import { chooseTiers, loadTiers, moveBody, tierCount, tierNames } from './tiers.js';
@@ -312,7 +312,7 @@ export async function createCreaturePopulation(renderer, options = {}) {
     },
     /** The shading controls now: { roughness, metalness, distanceRange } (CREATURE.look at creation). */
     get look() {
-      return { roughness: state.look.roughness.value, metalness: state.look.metalness.value, distanceRange: state.look.distanceRange.value };
+      return Object.fromEntries(Object.entries(state.look).map(([name, node]) => [name, node.value]));
     },
     /**
      * Change shading controls ({ roughness?, metalness?, distanceRange? }, each in the spec's range): uniform
@@ -322,6 +322,8 @@ export async function createCreaturePopulation(renderer, options = {}) {
     setLook(changes) {
       checkLook(changes);
       for (const [name, value] of Object.entries(changes)) state.look[name].value = value;
+      // The occlusion is stored by the pre-pass: every live body is deformed again now.
+      if (Object.keys(changes).some((name) => LOOK_DEFORM.includes(name))) for (const page of pages) deformAll(state, page);
       return population.look;
     },
     /** Switch every page to debug mode `m` (a variant built on first use; 'off' is the shipped one). */

@@ -18,6 +18,8 @@ export const CREATURE = Object.freeze({
   "gradientFloor": 1e-12,
   "kFloor": 0.00124,
   "look": {
+    "aoRadius": 0.05,
+    "aoTaps": 0,
     "distanceRange": 0.005,
     "metalness": 0.0,
     "roughness": 0.55
@@ -123,7 +125,7 @@ export const CREATURE = Object.freeze({
   "registers": 13,
   "roundCone": [0, 0, 0, 0, 0, 0, 0],
   "signatures": {
-    "compilerSignature": "46b15505d2ec68a6c8da4d7afd37ede9339ed0f34dd05bc970c80c5085cb867b",
+    "compilerSignature": "a593793a62d4c2d08bdd06b86dc6d6a174e1b3319b14f2222edb2b1cb8dd303c",
     "geometryDigest": "400b0d18a2a9f6bbbfe5b441f89767f552a4f3b4c45a368d1129d632e1d2f4f1",
     "topologySignature": "330d551e8c006f84b01459c84db69ca8c43aec5bc9d9083d3e85c291be5a68bf"
   },
@@ -191,7 +193,7 @@ export const CREATURE = Object.freeze({
       "projectedSizeMaxPx": 186.69647541568403,
       "registers": 13,
       "signatures": {
-        "compilerSignature": "46b15505d2ec68a6c8da4d7afd37ede9339ed0f34dd05bc970c80c5085cb867b",
+        "compilerSignature": "a593793a62d4c2d08bdd06b86dc6d6a174e1b3319b14f2222edb2b1cb8dd303c",
         "geometryDigest": "400b0d18a2a9f6bbbfe5b441f89767f552a4f3b4c45a368d1129d632e1d2f4f1",
         "topologySignature": "330d551e8c006f84b01459c84db69ca8c43aec5bc9d9083d3e85c291be5a68bf"
       },

@@ -201,6 +201,10 @@ export interface LookData {
   readonly metalness: number;
   /** The 'distance' debug view's colour range, a fraction of the body scale. */
   readonly distanceRange: number;
+  /** Field self-occlusion taps along each vertex's normal (0: off). */
+  readonly aoTaps: number;
+  /** How far the occlusion taps reach, a fraction of the body scale. */
+  readonly aoRadius: number;
 }
 
 /** The reference surface's size. */
