@@ -57,7 +57,7 @@ WEB_LAB = REPO / "generator" / "creaturegen" / "web_lab"
 HOPPER_SPEC = REPO / "examples" / "reference" / "hopper.json"
 HOPPER_SLUG = "hopper-squash-core"
 DEFAULT_PACKAGE = REPO / "out" / HOPPER_SLUG
-VARIANTS = ("shipped", "baseline", "lbs")
+VARIANTS = ("shipped", "baseline", "lbs", "ao")
 #: The field-query kernels (the plain-LBS baseline queries no field).
 FIELD_VARIANTS = ("shipped", "baseline")
 #: The issue 27 bar: a visible moving hero body at most this many times the plain-LBS body.
@@ -242,6 +242,8 @@ def measure_population(
         statistics.median(rd["baseline"]["ms"]) / statistics.median(rd["shipped"]["ms"]) for rd in rounds
     ]
     over_lbs = [statistics.median(rd["shipped"]["ms"]) / statistics.median(rd["lbs"]["ms"]) for rd in rounds]
+    # The shipped pre-pass with the field's self-occlusion on (4 taps; creature-bench.js AO_LOOK) over off.
+    ao_over = [statistics.median(rd["ao"]["ms"]) / statistics.median(rd["shipped"]["ms"]) for rd in rounds]
     return {
         "bodies": bodies,
         "live_bodies": int(state["count"]),
@@ -276,6 +278,7 @@ def measure_population(
             "p50_over_p50": variants["baseline"]["ms"]["p50"] / variants["shipped"]["ms"]["p50"],
         },
         "ratio_shipped_over_lbs": {"per_round": over_lbs, "median": float(statistics.median(over_lbs))},
+        "ratio_ao_over_shipped": {"per_round": ao_over, "median": float(statistics.median(ao_over))},
     }
 
 
@@ -376,6 +379,10 @@ def run_package(folder: Path, args: argparse.Namespace, log: Callable[[str], Non
         slope_ratio = baseline_fit["slope"] / shipped_fit["slope"]
     if shipped_fit is not None and lbs_fit is not None and lbs_fit["slope"] > 0:
         lbs_ratio = shipped_fit["slope"] / lbs_fit["slope"]
+    ao_fit = marginal["ao"]
+    ao_ratio = None
+    if shipped_fit is not None and ao_fit is not None and shipped_fit["slope"] > 0:
+        ao_ratio = ao_fit["slope"] / shipped_fit["slope"]
     shadow_passes = sorted({n - 1 for p in populations for n in p["draws"]["passes_drawing_bodies"]})
     workload = {
         "slots": slots,
@@ -436,6 +443,7 @@ def run_package(folder: Path, args: argparse.Namespace, log: Callable[[str], Non
             **marginal,
             "ratio_baseline_over_shipped": slope_ratio,
             "ratio_shipped_over_lbs": lbs_ratio,
+            "ratio_ao_over_shipped": ao_ratio,
         },
         "targets": [
             {
@@ -506,10 +514,12 @@ def table(report: dict[str, Any]) -> str:
 
         ratio = m["marginal_per_body_ratio"]
         over_lbs = mg["ratio_shipped_over_lbs"]
+        ao = mg["ratio_ao_over_shipped"]
         lines.append(
             f"marginal ms/body: shipped {slope(mg['shipped'])}, baseline {slope(mg['baseline'])}"
             f" (ratio {'n/a' if ratio is None else f'{ratio:.2f}'}), plain LBS {slope(mg['lbs'])}"
-            f" (shipped/LBS {'n/a' if over_lbs is None else f'{over_lbs:.2f}'})"
+            f" (shipped/LBS {'n/a' if over_lbs is None else f'{over_lbs:.2f}'}), with self-occlusion "
+            f"{slope(mg['ao'])} (ao/shipped {'n/a' if ao is None else f'{ao:.2f}'})"
         )
         lines.append(
             f"field query ({f['points']} points): shipped {f['ms_per_dispatch']['shipped']['p50']:.1f} ms, "

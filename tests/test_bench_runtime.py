@@ -114,6 +114,7 @@ def test_runtime_benchmark_smoke(tmp_path: Path, capsys: pytest.CaptureFixture[s
         assert all(_positive_finite(first[v]) for v in bench.VARIANTS)
         assert _positive_finite(population["ratio_baseline_over_shipped"]["median"])
         assert _positive_finite(population["ratio_shipped_over_lbs"]["median"])
+        assert _positive_finite(population["ratio_ao_over_shipped"]["median"])
 
     marginal = result["marginal_ms_per_body"]
     for variant in bench.VARIANTS:

@@ -21,7 +21,7 @@ const fdStep = Number(params.get('fdStep') ?? 1e-3);
 // The sun's shadow map (a second pass through every body's vertex path); on by default, as in the lab.
 const shadows = (params.get('shadows') ?? '1') !== '0';
 // The pre-pass variants to build and compile (the crowd bench times the shipped one only).
-const wanted = (params.get('variants') ?? 'shipped,baseline,lbs').split(',');
+const wanted = (params.get('variants') ?? 'shipped,baseline,lbs,ao').split(',');
 const out = document.getElementById('out');
 
 // Draw calls and render passes, counted at the WebGPU encoders (what was submitted, not what three meant to).
@@ -110,12 +110,17 @@ async function main() {
     baseline: () => pop.pages.map((p) => createBaselineKernel(tsl, layout, p, internals.records, internals.order, internals.programs, step)),
     // What a SkinnedMesh does: linear blend skinning alone, no correction, no field (lab code too).
     lbs: () => pop.pages.map((p) => createLbsKernel(tsl, layout, p, internals.records, internals.programs)),
+    // The shipped pre-pass with the field's self-occlusion on (look.aoTaps; the same kernels: the taps
+    // are a uniform loop bound).
+    ao: () => pop.pages.map((p) => p.kernel),
   };
+  const AO_LOOK = { aoTaps: 4, aoRadius: 0.08 };
   const kernels = Object.fromEntries(wanted.map((v) => [v, builders[v]()]));
   let variant = 'shipped';
   function setVariant(v) {
-    if (!(v in kernels)) throw new Error(`variant: shipped, baseline or lbs (got ${v})`);
+    if (!(v in kernels)) throw new Error(`variant: ${Object.keys(kernels).join(', ')} (got ${v})`);
     pop.pages.forEach((p, i) => { p.kernel = kernels[v][i]; });
+    if ((v === 'ao') !== (variant === 'ao')) pop.setLook(v === 'ao' ? AO_LOOK : { aoTaps: 0 });
     variant = v;
   }
   function render() { renderer.render(scene, camera); }
