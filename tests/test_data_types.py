@@ -135,6 +135,7 @@ EXPECTED = {
     "ColourGenetics": {"hueRad": "number"},
     "CorrectionData": {"earlyOut": "number"},
     "MeshCounts": {"triangles": "number"},
+    "LookData": {"roughness": "number", "aoTaps": "number", "distanceRange": "number"},
 }
 
 
