@@ -128,29 +128,6 @@ def no_build_pictures() -> Iterator[None]:
         yield
 
 
-#: Test modules whose tests take longest (worker-seconds in a `make test` run), started first: xdist hands
-#: tests out in collection order, so a long module collected last keeps one worker busy while the other one
-#: idles (about 50 s of the 847 s at f42623b). Each module stays contiguous, so its module-scoped fixtures
-#: are set up once per worker as before; every other module keeps its place after these.
-SLOW_FIRST = (
-    "test_corpus.py",
-    "test_consumer.py",
-    "test_batch.py",
-    "test_creature_parity.py",
-    "test_frost_parity.py",
-    "test_surface_build.py",
-    "test_creature_tiers.py",
-    "test_frost_pointer.py",
-    "test_bench_frost.py",
-)
-
-
-def pytest_collection_modifyitems(items: list[pytest.Item]) -> None:
-    rank = {name: k for k, name in enumerate(SLOW_FIRST)}
-    order = {id(item): k for k, item in enumerate(items)}
-    items.sort(key=lambda item: (rank.get(item.path.name, len(SLOW_FIRST)), order[id(item)]))
-
-
 @pytest.fixture(scope="session")
 def creature_out(tmp_path_factory: pytest.TempPathFactory) -> Path:
     """One output folder for example packages, shared by every test (and worker) that needs a built
