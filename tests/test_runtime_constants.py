@@ -126,3 +126,6 @@ def test_set_look_ranges_are_the_spec_ones() -> None:
         low = bounds[Ge].ge if Ge in bounds else bounds[Gt].gt
         spec[name] = (float(low), float(bounds[Le].le), Ge in bounds)
     assert js == spec
+    (integers,) = re.findall(r"^export const LOOK_INTEGERS = Object\.freeze\((\[.*\])\);$", source, re.M)
+    whole = sorted(name for name, info in Look.model_fields.items() if info.annotation is int)
+    assert sorted(json.loads(integers.replace("'", '"'))) == whole == ["aoTaps"]

@@ -10,6 +10,7 @@ import {
   createCreaturePopulation,
   createMotion,
 } from 'hopper-squash-core';
+import type { LookData } from 'hopper-squash-core';
 import { createDiagnostics } from 'hopper-squash-core/diagnostics';
 import { createCreaturePopulation as createQuadrupeds } from 'quadruped-rope-tail';
 import { createFrostEffect } from 'frost-pane-balanced';
@@ -29,6 +30,8 @@ export async function typed(renderer: THREE.WebGPURenderer, scene: THREE.Scene, 
   const moved: number = hoppers.chooseTiers(camera, 720) + hoppers.tiers.length;
   const kept: boolean = hoppers.setBodyTier(id, hoppers.tiers[hoppers.tiers.length - 1].name);
   hoppers.setDebugMode(DEBUG_MODES[0]);
+  const look: LookData = hoppers.setLook({ roughness: 0.4, aoTaps: 0 });
+  console.assert(look.roughness === hoppers.look.roughness);
   const diagnostics = createDiagnostics(renderer, hoppers);
   const pose: Float32Array = await diagnostics.readPose(id);
   const staged: Float32Array = diagnostics.stagedPose(id);

@@ -54,6 +54,7 @@ class SamplingBackends:
         self._requested = requested
         self._progress = progress
         self._numpy = NumpyBackend(rig.graph, rig.slots)
+        self._requested_backend: FieldBackend | None = None
         self._points: Points | None = None
         self._t_numpy: float | None = None
         self._gpu: FieldBackend | None = None
@@ -63,9 +64,9 @@ class SamplingBackends:
     def for_lattice(self, nodes: int) -> tuple[FieldBackend, str]:
         """The backend for a lattice of ``nodes`` nodes, and why."""
         if self._requested != "auto":
-            if self._gpu is None:
-                self._gpu = make_backend(self._requested, self._rig.graph, self._rig.slots)
-            return self._gpu, "requested"
+            if self._requested_backend is None:
+                self._requested_backend = make_backend(self._requested, self._rig.graph, self._rig.slots)
+            return self._requested_backend, "requested"
         points = self._calibration_points()
         if self._t_numpy is None:
             self._t_numpy = time_backend(self._numpy, points, repeats=2)

@@ -129,6 +129,20 @@ async function main() {
     if (!targets.has(key)) targets.set(key, new THREE.RenderTarget(w, h, { depthBuffer: true }));
     return targets.get(key);
   }
+  // Device create* calls made by `run` (awaited, then the queue drained), added into `created`.
+  async function countCreated(created, run) {
+    const start = { ...deviceCounts };
+    const result = await run();
+    await device.queue.onSubmittedWorkDone();
+    for (const [k, v] of Object.entries(deviceCounts)) created[k] = (created[k] ?? 0) + v - start[k];
+    return result;
+  }
+  // Body i's deform storage read back, every array as base64 of its float32 bytes.
+  async function deformedBase64(i) {
+    const r = await diag.readDeformed(i);
+    return Object.fromEntries(Object.entries(r).map(([k, a]) => [k, toBase64(new Uint8Array(a.buffer))]));
+  }
+
   // A readback's rows are padded to 256 bytes (WebGPU's bytesPerRow); `texel` is bytes per pixel (4 for
   // RGBA8, 16 for RGBA32F), and the result is the tightly packed array of the target's own type.
   async function readTarget(target, w, h, texel = 4) {
@@ -487,14 +501,7 @@ async function main() {
       frame();
       const a = await readTarget(target, width, height);
       const created = {};
-      const count = async (change) => {
-        const start = { ...deviceCounts };
-        const now = pop.setLook(change);
-        frame();
-        await device.queue.onSubmittedWorkDone();
-        for (const [k, v] of Object.entries(deviceCounts)) created[k] = (created[k] ?? 0) + v - start[k];
-        return now;
-      };
+      const count = (change) => countCreated(created, () => { const now = pop.setLook(change); frame(); return now; });
       const during = await count(changes);
       const b = await readTarget(target, width, height);
       await count(before);
@@ -576,36 +583,23 @@ async function main() {
      */
     async aoCheck(changes, i = 0) {
       const before = { ...pop.look };
-      const read = async () => {
-        const r = await diag.readDeformed(i);
-        return { position: toBase64(new Uint8Array(r.position.buffer)), gradient: toBase64(new Uint8Array(r.gradient.buffer)),
-          colour: toBase64(new Uint8Array(r.colour.buffer)), program: toBase64(new Uint8Array(r.program.buffer)) };
-      };
-      const off = await read();
+      const off = await deformedBase64(i);
       const created = {};
-      const change = async (c) => {
-        const start = { ...deviceCounts };
+      const change = (c) => countCreated(created, () => {
         const deformed = pop.stats.deformDispatches;
         pop.setLook(c);
         pop.flush();
         render();
-        await device.queue.onSubmittedWorkDone();
-        for (const [k, v] of Object.entries(deviceCounts)) created[k] = (created[k] ?? 0) + v - start[k];
         return pop.stats.deformDispatches - deformed;
-      };
+      });
       const dispatches = await change(changes);
-      const on = await read();
+      const on = await deformedBase64(i);
       await change(before);
-      const back = await read();
+      const back = await deformedBase64(i);
       return { look: { ...changes }, dispatches, created, off, on, back };
     },
     /** What the display and shadow passes draw (the page's deform storage), read back. */
-    async readDeformed(i = 0) {
-      const r = await diag.readDeformed(i);
-      return { position: toBase64(new Uint8Array(r.position.buffer)), gradient: toBase64(new Uint8Array(r.gradient.buffer)),
-        distance: toBase64(new Uint8Array(r.distance.buffer)), accepted: toBase64(new Uint8Array(r.accepted.buffer)),
-        colour: toBase64(new Uint8Array(r.colour.buffer)), program: toBase64(new Uint8Array(r.program.buffer)) };
-    },
+    readDeformed: (i = 0) => deformedBase64(i),
     capturePixels,
     displayPath,
     shadowParity,

@@ -43,7 +43,7 @@ export const rootNormal = (root1, n) => {
 
 /**
  * The shading controls as uniform nodes, one set per population and shared by every page and variant, so
- * setting one is a single uniform write (LookData: roughness, metalness, distanceRange).
+ * setting one is a single uniform write (LookData: roughness, metalness, distanceRange, aoTaps, aoRadius).
  */
 export function createLookUniforms(look) {
   return {
@@ -59,7 +59,7 @@ export function createLookUniforms(look) {
 export const LOOK_RANGES = Object.freeze({ roughness: [0, 1, true], metalness: [0, 1, true], distanceRange: [0, 0.1, false], aoTaps: [0, 8, true], aoRadius: [0, 0.25, false] });
 /** The controls that are whole numbers. */
 export const LOOK_INTEGERS = Object.freeze(['aoTaps']);
-/** The controls the deform pre-pass reads (a change re-deforms every live body at the next flush). */
+/** The controls the deform pre-pass reads (setLook re-deforms every live body when one changes). */
 export const LOOK_DEFORM = Object.freeze(['aoTaps', 'aoRadius']);
 
 /** `changes` checked against LOOK_RANGES: throws a RangeError naming the control, else returns it. */
