@@ -125,7 +125,7 @@ export const CREATURE = Object.freeze({
   "registers": 13,
   "roundCone": [0, 0, 0, 0, 0, 0, 0],
   "signatures": {
-    "compilerSignature": "a593793a62d4c2d08bdd06b86dc6d6a174e1b3319b14f2222edb2b1cb8dd303c",
+    "compilerSignature": "731a7c05bb33fe82d0e0e2402ea7db889f19748c8a820a0c03e09876f7bf374a",
     "geometryDigest": "400b0d18a2a9f6bbbfe5b441f89767f552a4f3b4c45a368d1129d632e1d2f4f1",
     "topologySignature": "330d551e8c006f84b01459c84db69ca8c43aec5bc9d9083d3e85c291be5a68bf"
   },
@@ -193,7 +193,7 @@ export const CREATURE = Object.freeze({
       "projectedSizeMaxPx": 186.69647541568403,
       "registers": 13,
       "signatures": {
-        "compilerSignature": "a593793a62d4c2d08bdd06b86dc6d6a174e1b3319b14f2222edb2b1cb8dd303c",
+        "compilerSignature": "731a7c05bb33fe82d0e0e2402ea7db889f19748c8a820a0c03e09876f7bf374a",
         "geometryDigest": "400b0d18a2a9f6bbbfe5b441f89767f552a4f3b4c45a368d1129d632e1d2f4f1",
         "topologySignature": "330d551e8c006f84b01459c84db69ca8c43aec5bc9d9083d3e85c291be5a68bf"
       },
